@@ -1,0 +1,6 @@
+//! candela-core: the rendering core of candela.
+//!
+//! A plain scene description (from `candela-scene`) is turned into a
+//! traceable [`scene`], which the integrators render onto a [`film`].
+
+pub mod spectrum;

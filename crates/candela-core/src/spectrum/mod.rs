@@ -1,0 +1,5 @@
+//! Spectral representation: sampled spectra, spectrum functions, colour.
+
+mod sampled;
+
+pub use sampled::*;

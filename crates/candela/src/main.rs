@@ -1,0 +1,2 @@
+//! The `candela` command-line renderer.
+fn main() {}
