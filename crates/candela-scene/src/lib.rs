@@ -51,3 +51,8 @@ pub fn parse_file(path: &Path) -> Result<SceneDescription, SceneError> {
 pub fn parse_str(text: &str, virtual_path: &Path) -> Result<SceneDescription, SceneError> {
     parser::parse_bytes(text.as_bytes().to_vec(), virtual_path)
 }
+
+/// Like [`parse_str`] for raw bytes (scene files need not be valid UTF-8).
+pub fn parse_bytes(bytes: &[u8], virtual_path: &Path) -> Result<SceneDescription, SceneError> {
+    parser::parse_bytes(bytes.to_vec(), virtual_path)
+}
