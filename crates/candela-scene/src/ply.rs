@@ -352,6 +352,15 @@ fn read_body<S: Source>(src: &mut S, elements: &[Element], len: usize) -> Result
         let want_n = has(|s| matches!(s, Slot::Normal(_)));
         let want_uv = has(|s| matches!(s, Slot::Uv(_)));
         let want_fi = has(|s| *s == Slot::FaceIndex);
+        if el.props.is_empty() && el.count > len {
+            return Err(SceneError::at(
+                &Loc::file_only(src.path()),
+                format!(
+                    "element '{}' claims {} records but has no properties",
+                    el.name, el.count
+                ),
+            ));
+        }
         let cap = el.count.min(len);
         if el.name == "vertex" {
             mesh.positions.reserve(cap);

@@ -33,7 +33,7 @@ pub enum ParamSpectrum {
 
 /// Turns a flat list of numbers into (λ, value) pairs.
 pub(crate) fn pairs(values: &[f32], loc: &Loc, what: &str) -> Result<Vec<(f32, f32)>, SceneError> {
-    if values.is_empty() || values.len() % 2 != 0 {
+    if values.is_empty() || values.len() % 2 == 1 {
         return Err(SceneError::at(
             loc,
             format!(
