@@ -1,6 +1,10 @@
 //! candela-core: the rendering core of candela.
 //!
 //! A plain scene description (from `candela-scene`) is turned into a
-//! traceable [`scene`], which the integrators render onto a [`film`].
+//! traceable scene, which the integrators render onto a film.
 
+pub mod bsdf;
+pub mod interaction;
+pub mod math;
+pub mod sampling;
 pub mod spectrum;
