@@ -7,9 +7,21 @@
 //! densities are per unit solid angle. The adjoint of non-symmetric BSDFs is
 //! selected by [`TransportMode`].
 
+mod conductor;
+mod dielectric;
 mod diffuse;
+pub mod fresnel;
+pub mod microfacet;
+mod thin_dielectric;
 
+#[cfg(test)]
+mod tests;
+
+pub use conductor::ConductorBxdf;
+pub use dielectric::DielectricBxdf;
 pub use diffuse::DiffuseBxdf;
+pub use microfacet::TrowbridgeReitz;
+pub use thin_dielectric::ThinDielectricBxdf;
 
 use crate::math::{Frame, Vec2, Vec3};
 use crate::sampling::PdfSolidAngle;
@@ -134,6 +146,12 @@ impl BsdfSample {
 pub enum Bxdf {
     /// Lambertian reflection.
     Diffuse(DiffuseBxdf),
+    /// Metal: mirror or Torrance–Sparrow reflection.
+    Conductor(ConductorBxdf),
+    /// Dielectric interface: smooth or rough reflection and refraction.
+    Dielectric(DielectricBxdf),
+    /// Thin dielectric sheet: delta reflection and straight transmission.
+    ThinDielectric(ThinDielectricBxdf),
 }
 
 /// Writes a `match` over every [`Bxdf`] variant that forwards to the inner model.
@@ -141,6 +159,9 @@ macro_rules! dispatch_bxdf {
     ($self:expr, $b:ident => $e:expr) => {
         match $self {
             Bxdf::Diffuse($b) => $e,
+            Bxdf::Conductor($b) => $e,
+            Bxdf::Dielectric($b) => $e,
+            Bxdf::ThinDielectric($b) => $e,
         }
     };
 }
@@ -183,6 +204,44 @@ impl Bxdf {
     #[inline]
     pub fn regularize(&mut self) {
         dispatch_bxdf!(self, b => b.regularize())
+    }
+    /// Monte Carlo estimate of the directional albedo ρ(wo) = ∫ f |cos θi| dωi
+    /// from one sample per pair of `uc[j]`, `u[j]` [pbrt-v4 §9.1.1]; delta lobes included.
+    pub fn rho(&self, wo: Vec3, uc: &[f32], u: &[Vec2], mode: TransportMode) -> SampledSpectrum {
+        debug_assert_eq!(uc.len(), u.len());
+        let mut sum = SampledSpectrum::zero();
+        for (&c, &u2) in uc.iter().zip(u) {
+            if let Some(bs) = self.sample_f(wo, c, u2, mode, SampleFlags::ALL) {
+                if bs.pdf.0 > 0.0 {
+                    sum += bs.f * (bs.wi.z.abs() / bs.pdf.0);
+                }
+            }
+        }
+        sum / uc.len().max(1) as f32
+    }
+}
+
+impl From<DiffuseBxdf> for Bxdf {
+    fn from(b: DiffuseBxdf) -> Self {
+        Self::Diffuse(b)
+    }
+}
+
+impl From<ConductorBxdf> for Bxdf {
+    fn from(b: ConductorBxdf) -> Self {
+        Self::Conductor(b)
+    }
+}
+
+impl From<DielectricBxdf> for Bxdf {
+    fn from(b: DielectricBxdf) -> Self {
+        Self::Dielectric(b)
+    }
+}
+
+impl From<ThinDielectricBxdf> for Bxdf {
+    fn from(b: ThinDielectricBxdf) -> Self {
+        Self::ThinDielectric(b)
     }
 }
 

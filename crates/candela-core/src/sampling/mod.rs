@@ -1,6 +1,8 @@
 //! Random numbers, hashing, warps from [0,1)² to common domains, tabulated
 //! distributions, and densities tagged with their measure.
 
+/// χ² goodness-of-fit harness for direction samplers (test support).
+pub mod chi2;
 mod distribution;
 mod hash;
 mod pdf;
