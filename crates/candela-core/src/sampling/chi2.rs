@@ -196,25 +196,45 @@ fn expected_counts(cfg: &Chi2Config, pdf: &impl Fn(Vec3) -> f32) -> Vec<f64> {
 
 /// Adaptive 2-D Simpson quadrature of `f` over `[z0, z1] × [φ0, φ1]`.
 ///
-/// A node compares the 3×3 Simpson rule with the sum over its four quadrants
-/// and accepts the Richardson-corrected fine value when they differ by less than
-/// 15·tol. tol, in probability, is a twentieth of the cell's Poisson standard
-/// deviation √(N p)/N (floored at 10⁻³ samples), so quadrature error adds under
-/// 0.25 % to the expected χ² contribution. Depth is capped at 6 (4096 sub-cells)
+/// The cell is first cut into `SUB × SUB` pieces so that a lobe narrower than
+/// the cell cannot slip between the nodes of both the coarse and the fine rule
+/// (adaptive Simpson's classic failure, which showed up as a 6·10⁻⁴ deficit in
+/// ∫p for a GGX lobe of α = 0.05). Each piece compares the 3×3 rule with the sum
+/// over its quadrants and accepts the Richardson-corrected value when they
+/// differ by under 15·tol. tol, in probability, is a fiftieth of the cell's
+/// Poisson standard deviation √(Np)/N (floored at 10⁻⁴ samples), shared among
+/// the pieces, so quadrature adds under 0.04 % to the expected χ² and under
+/// one sample to the total over the 8192 default cells. Depth is capped at 5
 /// for discontinuities such as the horizon of a hemisphere lobe.
 fn integrate_cell(f: &impl Fn(f64, f64) -> f64, b: [f64; 4], n: f64) -> f64 {
-    let mut v = [[0.0; 3]; 3];
-    for (i, row) in v.iter_mut().enumerate() {
-        for (j, x) in row.iter_mut().enumerate() {
-            *x = f(
-                lerp(b[0], b[1], i as f64 / 2.0),
-                lerp(b[2], b[3], j as f64 / 2.0),
-            );
+    const SUB: usize = 4;
+    let pieces = (0..SUB * SUB).map(|k| {
+        let (i, j) = ((k / SUB) as f64, (k % SUB) as f64);
+        let s = SUB as f64;
+        let pb = [
+            lerp(b[0], b[1], i / s),
+            lerp(b[0], b[1], (i + 1.0) / s),
+            lerp(b[2], b[3], j / s),
+            lerp(b[2], b[3], (j + 1.0) / s),
+        ];
+        let mut v = [[0.0; 3]; 3];
+        for (i, row) in v.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x = f(
+                    lerp(pb[0], pb[1], i as f64 / 2.0),
+                    lerp(pb[2], pb[3], j as f64 / 2.0),
+                );
+            }
         }
-    }
-    let coarse = simpson3(&v, b);
-    let tol = (0.05 * (coarse.max(0.0) * n).sqrt()).max(1e-3) / n;
-    adaptive(f, b, v, coarse, tol, 6)
+        (pb, v, simpson3(&v, pb))
+    });
+    let pieces: Vec<_> = pieces.collect();
+    let coarse: f64 = pieces.iter().map(|p| p.2).sum();
+    let tol = (0.02 * (coarse.max(0.0) * n).sqrt()).max(1e-4) / n / (SUB * SUB) as f64;
+    pieces
+        .into_iter()
+        .map(|(pb, v, c)| adaptive(f, pb, v, c, tol, 5))
+        .sum()
 }
 
 fn adaptive(

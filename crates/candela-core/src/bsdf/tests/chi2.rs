@@ -4,6 +4,7 @@
 //! outgoing directions × both transport modes), split per run with Šidák's
 //! correction, so the whole suite rejects a correct sampler with probability
 //! 1 % for a random seed (the seeds are fixed, so the outcome is deterministic).
+//! Set `CHI2_VERBOSE=1` (with `--nocapture`) to print every run's statistic.
 
 use super::{cases, cases_named, Case, MODES};
 use crate::bsdf::SampleFlags;
@@ -36,6 +37,9 @@ fn run(cases: &[Case]) -> Vec<String> {
                     },
                     |wi| b.pdf(wo, wi, mode, SampleFlags::ALL).0,
                 );
+                if std::env::var("CHI2_VERBOSE").is_ok() {
+                    eprintln!("{} wo={wo} {mode:?}: {report}", case.name);
+                }
                 if let Err(e) = report.check(alpha) {
                     failures.push(format!("{} wo={wo} {mode:?}: {e}", case.name));
                 }
