@@ -3,8 +3,10 @@
 //! A plain scene description (from `candela-scene`) is turned into a
 //! traceable scene, which the integrators render onto a film.
 
+pub mod accel;
 pub mod bsdf;
 pub mod interaction;
 pub mod math;
 pub mod sampling;
+pub mod shape;
 pub mod spectrum;

@@ -1,0 +1,1 @@
+//! Acceleration structures for ray queries over many primitives.

@@ -1,0 +1,1 @@
+//! Tests of intersection, error bounds and sampling for all shapes.
