@@ -26,6 +26,8 @@ mod sphere;
 mod triangle;
 
 #[cfg(test)]
+mod sampling_tests;
+#[cfg(test)]
 mod tests;
 
 pub use disk::Disk;

@@ -30,9 +30,6 @@ use crate::math::{
 use crate::sampling::{PdfArea, PdfSolidAngle};
 use std::sync::Arc;
 
-/// sin²(1.5°): below it the cone is sampled with a Taylor expansion [pbrt-v4].
-const SIN2_SMALL_CONE: f32 = 0.000_685_23;
-
 /// A sphere of given radius around the object-space origin, clipped to
 /// `z ∈ [z_min, z_max]` and `φ ∈ [0, φ_max]`.
 #[derive(Clone, Debug)]
@@ -276,15 +273,12 @@ impl Sphere {
         let (c, r) = self.render_center_radius();
         let sin_theta_max = r / ctx.p.distance(c);
         let sin2_theta_max = sin_theta_max * sin_theta_max;
-        let cos_theta_max = safe_sqrt(1.0 - sin2_theta_max);
-        let mut one_minus_cos_max = 1.0 - cos_theta_max;
-        let mut cos_theta = (cos_theta_max - 1.0) * u.x + 1.0;
-        let mut sin2_theta = 1.0 - cos_theta * cos_theta;
-        if sin2_theta_max < SIN2_SMALL_CONE {
-            sin2_theta = sin2_theta_max * u.x;
-            cos_theta = (1.0 - sin2_theta).sqrt();
-            one_minus_cos_max = sin2_theta_max / 2.0;
-        }
+        let one_minus_cos_max = one_minus_cos(sin2_theta_max);
+        // 1 − cos θ is uniform in [0, 1 − cos θ_max]; sin²θ = (1 − cos θ)(1 + cos θ)
+        // keeps full precision for tiny cones (pbrt-v4 switches to a Taylor series).
+        let one_minus_cos_theta = u.x * one_minus_cos_max;
+        let cos_theta = 1.0 - one_minus_cos_theta;
+        let sin2_theta = one_minus_cos_theta * (2.0 - one_minus_cos_theta);
         // Angle α at the centre between the axis and the sampled point.
         let cos_alpha =
             sin2_theta / sin_theta_max + cos_theta * safe_sqrt(1.0 - sin2_theta / sin2_theta_max);
@@ -322,14 +316,14 @@ impl Sphere {
         if t <= 0.0 || (d - t * wi).length_squared() > r * r * (1.0 + 1e-4) {
             return PdfSolidAngle(0.0);
         }
-        let sin2_theta_max = r * r / d.length_squared();
-        let one_minus_cos_max = if sin2_theta_max < SIN2_SMALL_CONE {
-            sin2_theta_max / 2.0
-        } else {
-            1.0 - safe_sqrt(1.0 - sin2_theta_max)
-        };
+        let one_minus_cos_max = one_minus_cos(r * r / d.length_squared());
         PdfSolidAngle(1.0 / (2.0 * PI * one_minus_cos_max))
     }
+}
+
+/// 1 − cos θ from sin²θ (θ ≤ π/2) without cancellation: sin²θ / (1 + cos θ).
+fn one_minus_cos(sin2: f32) -> f32 {
+    sin2 / (1.0 + safe_sqrt(1.0 - sin2))
 }
 
 /// Azimuth of an object-space point in [0, 2π).

@@ -6,23 +6,28 @@ use crate::sampling::{sample_uniform_sphere, Pcg32};
 use glam::DVec3;
 use std::sync::Arc;
 
-fn u2(r: &mut Pcg32) -> Vec2 {
+pub(super) fn u2(r: &mut Pcg32) -> Vec2 {
     Vec2::new(r.uniform_f32(), r.uniform_f32())
 }
 
-fn dir(r: &mut Pcg32) -> Vec3 {
+pub(super) fn dir(r: &mut Pcg32) -> Vec3 {
     sample_uniform_sphere(u2(r))
 }
 
 /// Rotation about a tilted axis, uniform scale `s`, then translation `t`.
-fn similarity(s: f32, t: Vec3) -> Arc<Transform> {
+pub(super) fn similarity(s: f32, t: Vec3) -> Arc<Transform> {
     let m = Mat4::from_translation(t)
         * Mat4::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7)
         * Mat4::from_scale(Vec3::splat(s));
     Arc::new(Transform::new(m, m.inverse()))
 }
 
-fn tri_mesh(p: Vec<Vec3>, idx: Vec<u32>, n: Option<Vec<Vec3>>, rev: bool) -> Arc<TriangleMesh> {
+pub(super) fn tri_mesh(
+    p: Vec<Vec3>,
+    idx: Vec<u32>,
+    n: Option<Vec<Vec3>>,
+    rev: bool,
+) -> Arc<TriangleMesh> {
     Arc::new(TriangleMesh::new(&Transform::IDENTITY, rev, idx, p, n, None, None).unwrap())
 }
 
