@@ -148,7 +148,7 @@ impl Disk {
     /// A point uniformly distributed by area.
     pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let area = self.area();
-        if !(area > 0.0) {
+        if area.is_nan() || area <= 0.0 {
             return None;
         }
         let full = self.inner_radius == 0.0 && self.phi_max >= 2.0 * PI;

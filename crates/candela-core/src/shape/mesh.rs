@@ -123,7 +123,7 @@ fn validate(
     uv: &Option<Vec<Vec2>>,
     face_indices: &Option<Vec<i32>>,
 ) -> Result<(), MeshError> {
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(MeshError::IndexCount(indices.len()));
     }
     if let Some(&index) = indices.iter().find(|&&i| i as usize >= nv) {

@@ -237,7 +237,7 @@ impl Sphere {
     /// A point uniformly distributed by area (uniform z and φ).
     pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let area = self.area();
-        if !(area > 0.0) {
+        if area.is_nan() || area <= 0.0 {
             return None;
         }
         let z = lerp(u.x, self.z_min, self.z_max);

@@ -296,7 +296,7 @@ impl Triangle {
     /// A point uniformly distributed by area; `None` for zero-area triangles.
     pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         let area = self.area();
-        if !(area > 0.0) {
+        if area.is_nan() || area <= 0.0 {
             return None;
         }
         let [p0, p1, p2] = self.positions();
