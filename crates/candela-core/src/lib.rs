@@ -4,6 +4,7 @@
 //! traceable scene, which the integrators render onto a film.
 
 pub mod bsdf;
+pub mod camera;
 pub mod interaction;
 pub mod math;
 pub mod sampling;
