@@ -7,5 +7,6 @@ pub mod bsdf;
 pub mod camera;
 pub mod interaction;
 pub mod math;
+pub mod sampler;
 pub mod sampling;
 pub mod spectrum;
