@@ -5,6 +5,7 @@
 
 pub mod bsdf;
 pub mod camera;
+pub mod film;
 pub mod interaction;
 pub mod math;
 pub mod sampler;
