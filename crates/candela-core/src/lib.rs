@@ -5,6 +5,7 @@
 
 pub mod bsdf;
 pub mod interaction;
+pub mod light;
 pub mod math;
 pub mod sampling;
 pub mod spectrum;

@@ -1,0 +1,1 @@
+//! Statistical and closed-form tests of the lights.
