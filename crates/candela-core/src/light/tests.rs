@@ -1,1 +1,0 @@
-//! Statistical and closed-form tests of the lights.
