@@ -55,7 +55,7 @@ fn frame_to_render(frame: &Frame) -> Transform {
     Transform::new(m, m.transpose())
 }
 
-/// pbrt-v4 `"point"`: intensity `I`, `scale`, optional `power` [lm], `from`.
+/// pbrt-v4 `"point"`: intensity `I`, `scale`, optional `power` (lm), `from`.
 pub fn point_light(
     render_from_light: &Transform,
     i: LightSpectrum,
@@ -71,8 +71,8 @@ pub fn point_light(
     PointLight::new(t, i, sc)
 }
 
-/// pbrt-v4 `"spot"`: `coneangle` θ_e and `conedeltaangle` [degrees], aimed
-/// from `from` to `to`; optional `power` [lm].
+/// pbrt-v4 `"spot"`: `coneangle` θ_e and `conedeltaangle` (degrees), aimed
+/// from `from` to `to`; optional `power` (lm).
 pub fn spot_light(
     render_from_light: &Transform,
     i: LightSpectrum,
@@ -98,7 +98,7 @@ pub fn spot_light(
 }
 
 /// pbrt-v4 `"distant"`: radiance `L` arriving from `from − to`; optional
-/// `illuminance` [lx] on a surface facing the light.
+/// `illuminance` (lx) on a surface facing the light.
 pub fn distant_light(
     render_from_light: &Transform,
     l: LightSpectrum,
@@ -117,7 +117,7 @@ pub fn distant_light(
 }
 
 /// pbrt-v4 `"diffuse"` area light on `shape` (render space): radiance `L`,
-/// `twosided`, optional `power` [lm].
+/// `twosided`, optional `power` (lm).
 pub fn diffuse_area_light(
     shape: Shape,
     l: LightSpectrum,
@@ -134,7 +134,7 @@ pub fn diffuse_area_light(
     DiffuseAreaLight::new(shape, l, sc, two_sided)
 }
 
-/// pbrt-v4 `"infinite"` with a constant `L`: optional `illuminance` [lx] on
+/// pbrt-v4 `"infinite"` with a constant `L`: optional `illuminance` (lx) on
 /// an upward-facing patch (E = πL for a uniform sky).
 pub fn uniform_infinite_light(
     l: LightSpectrum,

@@ -1,7 +1,7 @@
 //! T3: power bookkeeping — Φ closed forms, β₀ of emitted samples, light selection.
 
 use super::*;
-use crate::math::{Transform, PI};
+use crate::math::{Ray, Transform, PI};
 
 fn point(i: f32, at: Vec3) -> Light {
     Light::Point(PointLight::new(Transform::translate(at), constant(i), 1.0))
@@ -220,4 +220,52 @@ fn pmfs_sum_to_one() {
         assert!((s - 1.0).abs() < 1e-5, "{s}");
     }
     assert!(LightSampler::power(&[]).sample(0.5).is_none());
+}
+
+#[test]
+fn create_applies_pbrt_v4_scaling() {
+    // With `power`/`illuminance` given, Φ (resp. E) equals the target divided
+    // by SpectrumToPhotometric(s) of the unit-scale spectrum — pbrt-v4's
+    // "1 nit" convention — whatever the spectrum's magnitude (here 7).
+    let lam = lambda();
+    let y = spectrum_photometric(&constant(1.0)) as f64;
+    let s = || constant(7.0);
+    let id = Transform::IDENTITY;
+    let check = |what: &str, got: f64, want: f64| {
+        assert!((got - want).abs() <= 1e-5 * want, "{what}: {got} vs {want}");
+    };
+    let p = point_light(&id, s(), 2.0, Some(1000.0), Vec3::ONE);
+    check("point power", p.phi(&lam)[0] as f64, 2.0 * 1000.0 / y);
+    let p = point_light(&id, s(), 2.0, None, Vec3::ONE);
+    check(
+        "point scale",
+        p.phi(&lam)[0] as f64,
+        4.0 * std::f64::consts::PI * 2.0 / y,
+    );
+    let sp = spot_light(&id, s(), 1.0, 40.0, 10.0, Some(500.0), Vec3::ZERO, Vec3::X);
+    check("spot power", sp.phi(&lam)[0] as f64, 500.0 / y);
+    for two in [false, true] {
+        let a = diffuse_area_light(square(Vec3::Z, 0.5, true), s(), 1.0, two, Some(300.0));
+        check("area power", a.phi(&lam)[0] as f64, 300.0 / y);
+    }
+    // Distant: E_v on a surface facing the light; sky: E = πL on an upward patch.
+    let ctx = LightSampleContext::at_point(Vec3::ZERO);
+    let d = distant_light(
+        &id,
+        s(),
+        1.0,
+        Some(80.0),
+        Vec3::new(0.0, 3.0, 4.0),
+        Vec3::ZERO,
+    );
+    let li = d.sample_li(&ctx, Vec2::ZERO, &lam).unwrap();
+    check("distant illuminance", li.l[0] as f64, 80.0 / y);
+    check(
+        "distant direction",
+        li.wi.dot(Vec3::new(0.0, 0.6, 0.8)) as f64,
+        1.0,
+    );
+    let sky = uniform_infinite_light(s(), 1.0, Some(120.0));
+    let le = sky.le(&Ray::new(Vec3::ZERO, Vec3::Z), &lam)[0] as f64;
+    check("sky illuminance", std::f64::consts::PI * le, 120.0 / y);
 }
