@@ -294,7 +294,7 @@ impl Light {
         }
     }
 
-    /// Total emitted power Φ [W] at the given wavelengths.
+    /// Total emitted power Φ (W) at the given wavelengths.
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         dispatch!(self, l => l.phi(lambda))
     }
