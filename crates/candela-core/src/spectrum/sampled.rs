@@ -72,7 +72,13 @@ impl SampledSpectrum {
     /// Per-sample division that yields 0 where the divisor is 0.
     #[inline]
     pub fn safe_div(self, d: Self) -> Self {
-        Self::from_fn(|i| if d.0[i] != 0.0 { self.0[i] / d.0[i] } else { 0.0 })
+        Self::from_fn(|i| {
+            if d.0[i] != 0.0 {
+                self.0[i] / d.0[i]
+            } else {
+                0.0
+            }
+        })
     }
     /// Per-sample square root.
     #[inline]
@@ -180,7 +186,10 @@ impl SampledWavelengths {
                 lambda[i] = lambda_min + (lambda[i] - lambda_max);
             }
         }
-        Self { lambda, pdf: [1.0 / span; N_SPECTRUM_SAMPLES] }
+        Self {
+            lambda,
+            pdf: [1.0 / span; N_SPECTRUM_SAMPLES],
+        }
     }
 
     /// Hero-style stratified sampling of the visible-importance density
@@ -273,8 +282,9 @@ mod tests {
             let l = sample_visible_wavelength(u);
             let n = 20_000;
             let h = (l - LAMBDA_MIN) / n as f32;
-            let cdf: f32 =
-                (0..n).map(|i| visible_wavelength_pdf(LAMBDA_MIN + (i as f32 + 0.5) * h) * h).sum();
+            let cdf: f32 = (0..n)
+                .map(|i| visible_wavelength_pdf(LAMBDA_MIN + (i as f32 + 0.5) * h) * h)
+                .sum();
             assert!((cdf - u).abs() < 2e-3, "u={u} cdf={cdf}");
         }
     }

@@ -1,0 +1,214 @@
+//! Padded Sobol sampler [pbrt-v4 §8.7.5 `PaddedSobolSampler`].
+//!
+//! Only the first two Sobol dimensions are used: dimension 0 is the van der
+//! Corput sequence (bit reversal) and dimension 1 is generated here from the
+//! primitive polynomial x + 1 with direction numbers m_k = 2m_{k−1} ⊕ m_{k−1},
+//! m_1 = 1 [Joe & Kuo 2008] — no table needed. Together they form a (0, 2)
+//! sequence: any 2^k consecutive aligned points have one point in every
+//! elementary interval of area 2^−k.
+//!
+//! Each 1D or 2D request ("dimension" d) gets its own copy of that 2D
+//! pattern, decorrelated from the others by
+//! * a hashed permutation of the sample index within the pixel (the
+//!   "padding" of Kollig & Keller 2002), and
+//! * an independent Owen scramble of every coordinate, seeded by a hash of
+//!   (pixel, d, seed). The scramble is the Laine–Karras style nested hash of
+//!   Burley 2020, §4, with the constants of Vegdahl 2021 ("Building a better LK
+//!   hash"); every output digit depends only on more significant input digits,
+//!   so it is a nested uniform-like scramble and preserves the net property.
+//!
+//! Everything is a pure function of (pixel, sample index, dimension, seed),
+//! so renders are deterministic under any thread schedule.
+
+use super::{pixel_hash, sample_from_bits};
+use crate::math::{UVec2, Vec2};
+
+/// Generator matrix columns of Sobol dimension 1 (column j for index bit j).
+const SOBOL_DIM1: [u32; 32] = sobol_dim1();
+
+/// Direction numbers of the polynomial x + 1: V_k = m_k·2^(32−k).
+const fn sobol_dim1() -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut m: u64 = 1;
+    let mut j = 0;
+    while j < 32 {
+        v[j] = (m << (31 - j)) as u32;
+        m ^= m << 1;
+        j += 1;
+    }
+    v
+}
+
+/// Unscrambled 32-bit Sobol value of `index` in dimension 0 or 1.
+#[inline]
+fn sobol_bits(index: u32, dim: u32) -> u32 {
+    if dim == 0 {
+        return index.reverse_bits();
+    }
+    let mut v = 0;
+    let mut a = index;
+    let mut j = 0;
+    while a != 0 {
+        if a & 1 != 0 {
+            v ^= SOBOL_DIM1[j];
+        }
+        a >>= 1;
+        j += 1;
+    }
+    v
+}
+
+/// Owen-style nested scramble by a hash whose low bits only affect higher
+/// bits, applied to the bit-reversed value [Burley 2020; Vegdahl 2021].
+#[inline]
+pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
+    let mut x = v.reverse_bits();
+    x ^= x.wrapping_mul(0x3d20_adea);
+    x = x.wrapping_add(seed);
+    x = x.wrapping_mul((seed >> 16) | 1);
+    x ^= x.wrapping_mul(0x0552_6c56);
+    x ^= x.wrapping_mul(0x53a2_2864);
+    x.reverse_bits()
+}
+
+/// A hashed bijection of `[0, 2^bits)`: xor, odd multiply and xorshift are
+/// each invertible modulo 2^bits.
+#[inline]
+fn mix_within(v: u32, bits: u32, seed: u64) -> u32 {
+    let mask = if bits >= 32 {
+        u32::MAX
+    } else {
+        (1u32 << bits) - 1
+    };
+    let (s0, s1) = (seed as u32, (seed >> 32) as u32);
+    let shift = (bits / 2).max(1);
+    let mut x = (v ^ s0) & mask;
+    x = x.wrapping_mul(s1 | 1) & mask;
+    x ^= x >> shift;
+    x = x
+        .wrapping_mul(0x9e37_79b9 ^ (s0 & 0xffff_fffe))
+        .wrapping_add(s1)
+        & mask;
+    x ^= x >> shift;
+    x = x.wrapping_mul((s0 >> 7) | 1) & mask;
+    x ^ (x >> shift)
+}
+
+/// Position of `i` in a hashed permutation of `[0, n)` (cycle walking over
+/// the next power of two keeps it a bijection for any `n`).
+#[inline]
+pub(crate) fn permute_index(i: u32, n: u32, seed: u64) -> u32 {
+    if n <= 1 {
+        return 0;
+    }
+    let bits = 32 - (n - 1).leading_zeros();
+    let mut v = mix_within(i, bits, seed);
+    while v >= n {
+        v = mix_within(v, bits, seed);
+    }
+    v
+}
+
+/// Padded Sobol sampler; see the module docs.
+#[derive(Clone, Debug)]
+pub struct PaddedSobolSampler {
+    spp: u32,
+    seed: u64,
+    pixel: UVec2,
+    sample_index: u32,
+    dimension: u32,
+}
+
+impl PaddedSobolSampler {
+    /// `spp` samples per pixel (powers of two give exact (0,m,2)-nets).
+    pub fn new(spp: u32, seed: u64) -> Self {
+        Self {
+            spp: spp.max(1),
+            seed,
+            pixel: UVec2::ZERO,
+            sample_index: 0,
+            dimension: 0,
+        }
+    }
+
+    /// Samples per pixel.
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.spp
+    }
+
+    /// Same sampler with a different seed.
+    pub fn with_seed(&self, seed: u64) -> Self {
+        Self::new(self.spp, seed)
+    }
+
+    /// Positions the sampler at (pixel, sample index, first dimension).
+    pub fn start_pixel_sample(&mut self, pixel: UVec2, sample_index: u32, dimension: u32) {
+        self.pixel = pixel;
+        self.sample_index = sample_index;
+        self.dimension = dimension;
+    }
+
+    /// Hash of the current dimension and the permuted sample index.
+    fn next(&mut self, used: u32) -> (u64, u32) {
+        let h = pixel_hash(self.pixel, self.dimension, self.seed);
+        self.dimension += used;
+        let index = permute_index(self.sample_index, self.spp, crate::sampling::mix_bits(h));
+        (h, index)
+    }
+
+    /// One scrambled Sobol coordinate.
+    pub fn get_1d(&mut self) -> f32 {
+        let (h, index) = self.next(1);
+        sample_from_bits(owen_scramble(sobol_bits(index, 0), (h >> 32) as u32))
+    }
+
+    /// Two scrambled Sobol coordinates (dimensions 0 and 1 of the pattern).
+    pub fn get_2d(&mut self) -> Vec2 {
+        let (h, index) = self.next(2);
+        Vec2::new(
+            sample_from_bits(owen_scramble(sobol_bits(index, 0), h as u32)),
+            sample_from_bits(owen_scramble(sobol_bits(index, 1), (h >> 32) as u32)),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dimension_one_matrix_is_pascal_mod_2() {
+        // m_k = 1, 3, 5, 15, 17, 51 (binomial coefficients mod 2).
+        let m: Vec<u32> = (0..6).map(|j| SOBOL_DIM1[j] >> (31 - j)).collect();
+        assert_eq!(m, [1, 3, 5, 15, 17, 51]);
+        // First points of dimension 1: 0, 1/2, 3/4, 1/4.
+        let v: Vec<u32> = (0..4).map(|i| sobol_bits(i, 1) >> 30).collect();
+        assert_eq!(v, [0, 2, 3, 1]);
+    }
+
+    #[test]
+    fn permutation_is_a_bijection() {
+        for n in [1u32, 2, 7, 16, 100, 1024] {
+            let mut seen = vec![false; n as usize];
+            for i in 0..n {
+                let p = permute_index(i, n, 0x1234_5678_9abc_def0 ^ n as u64) as usize;
+                assert!(!seen[p]);
+                seen[p] = true;
+            }
+        }
+    }
+
+    #[test]
+    fn scramble_is_nested() {
+        // Values sharing their top k bits keep sharing them after scrambling.
+        for seed in [1u32, 0xdead_beef, 77] {
+            for k in 1..12 {
+                let a = 0x5a5a_5a5au32;
+                let b = a ^ (1 << (31 - k));
+                let (sa, sb) = (owen_scramble(a, seed), owen_scramble(b, seed));
+                assert_eq!(sa >> (32 - k), sb >> (32 - k));
+                assert_ne!(sa >> (31 - k), sb >> (31 - k));
+            }
+        }
+    }
+}

@@ -1,0 +1,34 @@
+//! Random numbers, hashing, warps from [0,1)² to common domains, tabulated
+//! distributions, and densities tagged with their measure.
+
+/// χ² goodness-of-fit harness for direction samplers (test support).
+pub mod chi2;
+mod distribution;
+mod hash;
+mod pdf;
+mod rng;
+mod warp;
+
+pub use distribution::{Distribution1D, Distribution2D};
+pub use hash::{hash_u64s, mix_bits};
+pub use pdf::{pdf_area_to_solid_angle, pdf_solid_angle_to_area, PdfArea, PdfSolidAngle};
+pub use rng::Pcg32;
+pub use warp::*;
+
+/// Largest float below 1: samples are clamped to `[0, ONE_MINUS_EPSILON]`.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Power heuristic with β = 2 for `nf` samples of density `f_pdf` against
+/// `ng` of `g_pdf` [Veach 1997, eq. 9.13].
+#[inline]
+pub fn power_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
+    let f = nf * f_pdf;
+    let g = ng * g_pdf;
+    if f.is_infinite() {
+        return 1.0;
+    }
+    if f == 0.0 && g == 0.0 {
+        return 0.0;
+    }
+    (f * f) / (f * f + g * g)
+}

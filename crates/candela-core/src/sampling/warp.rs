@@ -1,0 +1,151 @@
+//! Warps from the unit square to disks, hemispheres, spheres, cones and
+//! triangles, each with its density [pbrt-v4 §A.5; Shirley & Chiu 1997].
+
+use crate::math::{safe_sqrt, Vec2, Vec3, INV_2PI, INV_4PI, INV_PI, PI};
+
+/// Concentric map of the square onto the unit disk [Shirley & Chiu 1997].
+#[inline]
+pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, PI / 4.0 * (o.y / o.x))
+    } else {
+        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Polar map of the square onto the unit disk.
+#[inline]
+pub fn sample_uniform_disk_polar(u: Vec2) -> Vec2 {
+    let r = u.x.sqrt();
+    let theta = 2.0 * PI * u.y;
+    Vec2::new(r * theta.cos(), r * theta.sin())
+}
+
+/// Cosine-weighted direction on the +z hemisphere (Malley's method).
+#[inline]
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = sample_uniform_disk_concentric(u);
+    let z = safe_sqrt(1.0 - d.x * d.x - d.y * d.y);
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Density of [`sample_cosine_hemisphere`]: cos θ / π.
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta * INV_PI
+}
+
+/// Uniform direction on the +z hemisphere.
+#[inline]
+pub fn sample_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = u.x;
+    let r = safe_sqrt(1.0 - z * z);
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Density of [`sample_uniform_hemisphere`]: 1/(2π).
+#[inline]
+pub fn uniform_hemisphere_pdf() -> f32 {
+    INV_2PI
+}
+
+/// Uniform direction on the unit sphere.
+#[inline]
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = safe_sqrt(1.0 - z * z);
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Density of [`sample_uniform_sphere`]: 1/(4π).
+#[inline]
+pub fn uniform_sphere_pdf() -> f32 {
+    INV_4PI
+}
+
+/// Uniform direction in the cone of half-angle acos(`cos_max`) around +z.
+#[inline]
+pub fn sample_uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let cos_t = (1.0 - u.x) + u.x * cos_max;
+    let sin_t = safe_sqrt(1.0 - cos_t * cos_t);
+    let phi = u.y * 2.0 * PI;
+    Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t)
+}
+
+/// Density of [`sample_uniform_cone`]: 1 / (2π(1 − cos_max)).
+#[inline]
+pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * (1.0 - cos_max))
+}
+
+/// Uniform barycentrics on a triangle [Heitz 2019, "A low-distortion map
+/// between triangle and square"]; returns (b0, b1, b2).
+#[inline]
+pub fn sample_uniform_triangle(u: Vec2) -> [f32; 3] {
+    let (b0, b1) = if u.x < u.y {
+        let b0 = u.x / 2.0;
+        (b0, u.y - b0)
+    } else {
+        let b1 = u.y / 2.0;
+        (u.x - b1, b1)
+    };
+    [b0, b1, 1.0 - b0 - b1]
+}
+
+/// Exponential distance sample with rate `a`.
+#[inline]
+pub fn sample_exponential(u: f32, a: f32) -> f32 {
+    -(1.0 - u).ln() / a
+}
+
+/// Samples the tent / linear density on [0,1] proportional to lerp(x, a, b).
+#[inline]
+pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if u == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let x = u * (a + b) / (a + (crate::math::lerp(u, a * a, b * b)).sqrt());
+    x.min(super::ONE_MINUS_EPSILON)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Pcg32;
+
+    #[test]
+    fn warps_stay_in_domain() {
+        let mut r = Pcg32::new(3, 1);
+        for _ in 0..10_000 {
+            let u = Vec2::new(r.uniform_f32(), r.uniform_f32());
+            assert!(sample_uniform_disk_concentric(u).length() <= 1.0 + 1e-6);
+            let w = sample_cosine_hemisphere(u);
+            assert!(w.z >= 0.0 && (w.length() - 1.0).abs() < 1e-5);
+            assert!((sample_uniform_sphere(u).length() - 1.0).abs() < 1e-5);
+            let c = sample_uniform_cone(u, 0.9);
+            assert!(c.z >= 0.9 - 1e-6);
+            let b = sample_uniform_triangle(u);
+            assert!(b.iter().all(|&x| (-1e-6..=1.0 + 1e-6).contains(&x)));
+        }
+    }
+
+    #[test]
+    fn cosine_hemisphere_mean_cos_is_two_thirds() {
+        // E[cos θ] under cos θ/π is 2/3; per-sample σ² = 1/2 − 4/9.
+        let mut r = Pcg32::new(11, 2);
+        let n = 400_000;
+        let m: f64 = (0..n)
+            .map(|_| sample_cosine_hemisphere(Vec2::new(r.uniform_f32(), r.uniform_f32())).z as f64)
+            .sum::<f64>()
+            / n as f64;
+        let sigma = (0.5f64 - 4.0 / 9.0).sqrt() / (n as f64).sqrt();
+        assert!((m - 2.0 / 3.0).abs() < 5.0 * sigma, "{m}");
+    }
+}

@@ -1,0 +1,156 @@
+//! Indexed triangle meshes stored in render space.
+//!
+//! Vertex data are transformed once at load time, so triangles intersect in
+//! render space without per-ray transforms [pbrt-v4 §6.5.1, `TriangleMesh`].
+//! Positions go through the point transform, normals through the inverse
+//! transpose; normals are negated when the shape's orientation is reversed,
+//! as pbrt-v4 does, so shading normals and geometric normals stay on the
+//! same side.
+
+use crate::math::{Transform, Vec2, Vec3};
+use thiserror::Error;
+
+/// Why a mesh description was rejected.
+#[derive(Debug, Error, PartialEq, Eq)]
+pub enum MeshError {
+    /// The index count is not a multiple of three.
+    #[error("triangle mesh has {0} indices, not a multiple of 3")]
+    IndexCount(usize),
+    /// An index refers past the vertex arrays.
+    #[error("triangle mesh index {index} out of range for {vertices} vertices")]
+    IndexOutOfRange {
+        /// The offending index.
+        index: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A per-vertex attribute array has the wrong length.
+    #[error("triangle mesh attribute \"{name}\" has {len} entries, expected {expected}")]
+    AttributeLength {
+        /// Attribute name (`N`, `uv`, `faceIndices`).
+        name: &'static str,
+        /// Given length.
+        len: usize,
+        /// Required length.
+        expected: usize,
+    },
+}
+
+/// A triangle mesh in render space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions (render space).
+    pub p: Vec<Vec3>,
+    /// Per-vertex shading normals (render space, already flipped by `reverse_orientation`).
+    pub n: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates.
+    pub uv: Option<Vec<Vec2>>,
+    /// Three vertex indices per triangle.
+    pub indices: Vec<u32>,
+    /// Per-triangle face index (for `ptex`-style lookups).
+    pub face_indices: Option<Vec<i32>>,
+    /// The shape's `ReverseOrientation` flag.
+    pub reverse_orientation: bool,
+    /// Whether the object-to-render transform flips handedness.
+    pub transform_swaps_handedness: bool,
+}
+
+impl TriangleMesh {
+    /// Builds a render-space mesh from object-space data.
+    pub fn new(
+        render_from_object: &Transform,
+        reverse_orientation: bool,
+        indices: Vec<u32>,
+        p: Vec<Vec3>,
+        n: Option<Vec<Vec3>>,
+        uv: Option<Vec<Vec2>>,
+        face_indices: Option<Vec<i32>>,
+    ) -> Result<Self, MeshError> {
+        validate(&indices, p.len(), &n, &uv, &face_indices)?;
+        let p = p.iter().map(|&q| render_from_object.point(q)).collect();
+        let n = n.map(|ns| {
+            ns.iter()
+                .map(|&v| {
+                    let w = render_from_object.normal(v);
+                    if reverse_orientation {
+                        -w
+                    } else {
+                        w
+                    }
+                })
+                .collect()
+        });
+        Ok(Self {
+            p,
+            n,
+            uv,
+            indices,
+            face_indices,
+            reverse_orientation,
+            transform_swaps_handedness: render_from_object.swaps_handedness(),
+        })
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// The three vertex indices of triangle `tri`.
+    #[inline]
+    pub fn vertex_indices(&self, tri: u32) -> [usize; 3] {
+        let i = 3 * tri as usize;
+        [
+            self.indices[i] as usize,
+            self.indices[i + 1] as usize,
+            self.indices[i + 2] as usize,
+        ]
+    }
+
+    /// The three render-space vertex positions of triangle `tri`.
+    #[inline]
+    pub fn positions(&self, tri: u32) -> [Vec3; 3] {
+        let v = self.vertex_indices(tri);
+        [self.p[v[0]], self.p[v[1]], self.p[v[2]]]
+    }
+}
+
+/// Checks index range and attribute lengths.
+fn validate(
+    indices: &[u32],
+    nv: usize,
+    n: &Option<Vec<Vec3>>,
+    uv: &Option<Vec<Vec2>>,
+    face_indices: &Option<Vec<i32>>,
+) -> Result<(), MeshError> {
+    if !indices.len().is_multiple_of(3) {
+        return Err(MeshError::IndexCount(indices.len()));
+    }
+    if let Some(&index) = indices.iter().find(|&&i| i as usize >= nv) {
+        return Err(MeshError::IndexOutOfRange {
+            index,
+            vertices: nv,
+        });
+    }
+    let check = |name, len, expected| {
+        if len == expected {
+            Ok(())
+        } else {
+            Err(MeshError::AttributeLength {
+                name,
+                len,
+                expected,
+            })
+        }
+    };
+    if let Some(n) = n {
+        check("N", n.len(), nv)?;
+    }
+    if let Some(uv) = uv {
+        check("uv", uv.len(), nv)?;
+    }
+    if let Some(f) = face_indices {
+        check("faceIndices", f.len(), indices.len() / 3)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,269 @@
+//! Sampling tests: area densities, solid-angle densities and their
+//! agreement, and Monte Carlo estimates of subtended solid angles.
+
+use super::tests::{dir, similarity, tri_mesh, u2};
+use super::*;
+use crate::math::Transform;
+use crate::sampling::Pcg32;
+use glam::DVec3;
+use std::sync::Arc;
+
+fn test_shapes() -> Vec<(&'static str, Shape)> {
+    let p = vec![
+        Vec3::new(0.3, -0.2, 2.0),
+        Vec3::new(1.4, 0.1, 2.6),
+        Vec3::new(0.2, 1.3, 2.2),
+    ];
+    vec![
+        (
+            "sphere",
+            Shape::Sphere(Sphere::new(
+                similarity(0.7, Vec3::new(0.5, 0.2, 3.0)),
+                false,
+                1.0,
+                -1.0,
+                1.0,
+                360.0,
+            )),
+        ),
+        (
+            "sphere-rev",
+            Shape::Sphere(Sphere::new(
+                similarity(1.3, Vec3::new(-2.0, 0.2, 1.0)),
+                true,
+                1.0,
+                -1.0,
+                1.0,
+                360.0,
+            )),
+        ),
+        (
+            "sphere-clipped",
+            Shape::Sphere(Sphere::new(
+                similarity(1.0, Vec3::new(0.0, 0.0, 4.0)),
+                false,
+                1.5,
+                -0.4,
+                1.1,
+                250.0,
+            )),
+        ),
+        (
+            "disk",
+            Shape::Disk(Disk::new(
+                similarity(2.0, Vec3::new(0.0, 1.0, 3.0)),
+                false,
+                0.2,
+                1.0,
+                0.0,
+                360.0,
+            )),
+        ),
+        (
+            "annulus-rev",
+            Shape::Disk(Disk::new(
+                similarity(1.0, Vec3::new(1.0, 0.0, 2.0)),
+                true,
+                0.0,
+                1.2,
+                0.4,
+                200.0,
+            )),
+        ),
+        (
+            "triangle",
+            Shape::Triangle(Triangle::new(
+                tri_mesh(p.clone(), vec![0, 1, 2], None, false),
+                0,
+            )),
+        ),
+        (
+            "triangle-rev",
+            Shape::Triangle(Triangle::new(tri_mesh(p, vec![0, 1, 2], None, true), 0)),
+        ),
+    ]
+}
+
+/// For triangles: signed distance of `p` from the plane and the winding normal.
+fn triangle_plane(shape: &Shape, p: Vec3) -> Option<(f32, Vec3)> {
+    let Shape::Triangle(t) = shape else {
+        return None;
+    };
+    let [a, b, c] = t.positions();
+    let n = (a - c).cross(b - c).normalize();
+    Some(((p - a).dot(n), n))
+}
+
+#[test]
+fn area_samples_lie_on_surface_with_uniform_density_and_oriented_normals() {
+    let mut r = Pcg32::new(3, 3);
+    for (name, shape) in test_shapes() {
+        let area = shape.area();
+        for _ in 0..2000 {
+            let s = shape.sample_area(u2(&mut r)).unwrap();
+            assert!((s.pdf.0 * area - 1.0).abs() < 1e-6, "{name}");
+            assert!((s.intr.n.length() - 1.0).abs() < 1e-5, "{name}");
+            // On the surface: a ray from outside the point, along −n, hits it.
+            let o = s.intr.p + s.intr.n * 1e-2;
+            let h = shape.intersect(&Ray::new(o, -s.intr.n), f32::INFINITY);
+            let h = h.unwrap_or_else(|| panic!("{name}: sample {:?} not on surface", s.intr.p));
+            assert!(h.si.p().distance(s.intr.p) < 1e-4, "{name}");
+            // Sampled and intersected normals agree (orientation included).
+            assert!(
+                h.si.n().dot(s.intr.n) > 0.999,
+                "{name}: {} vs {}",
+                h.si.n(),
+                s.intr.n
+            );
+            let reversed = name.ends_with("-rev");
+            if let Some((dist, n_wind)) = triangle_plane(&shape, s.intr.p) {
+                assert!(dist.abs() < 1e-5, "{name}");
+                assert_eq!(n_wind.dot(s.intr.n) > 0.0, !reversed, "{name}");
+            } else if let Shape::Sphere(_) = shape {
+                let c = shape.bounds().centroid();
+                let outward = (s.intr.p - c).dot(s.intr.n) > 0.0;
+                assert_eq!(outward, !reversed, "{name}");
+            }
+        }
+    }
+}
+
+#[test]
+fn sample_from_density_agrees_with_pdf_from() {
+    let mut r = Pcg32::new(5, 3);
+    for (name, shape) in test_shapes() {
+        if name == "sphere-clipped" {
+            continue; // its far side can hide behind its near side
+        }
+        let c = shape.bounds().centroid();
+        let (mut checked, mut zero) = (0, 0);
+        for k in 0..3000 {
+            // Near, far, and (for spheres) inside reference points.
+            let dist = [0.3, 2.0, 8.0][k % 3];
+            let ctx = ShapeSampleContext::from_point(c + dir(&mut r) * dist);
+            let Some(s) = shape.sample_from(&ctx, u2(&mut r)) else {
+                continue;
+            };
+            let wi = (s.intr.p - ctx.p).normalize();
+            if s.intr.n.dot(wi).abs() < 1e-2 {
+                continue;
+            }
+            let pdf = shape.pdf_from(&ctx, wi);
+            checked += 1;
+            if pdf.0 == 0.0 {
+                zero += 1;
+                continue;
+            }
+            assert!(
+                (pdf.0 / s.pdf.0 - 1.0).abs() < 2e-3,
+                "{name}: {} vs {}",
+                pdf.0,
+                s.pdf.0
+            );
+        }
+        assert!(
+            checked > 1000 && zero <= checked / 1000,
+            "{name}: {zero} of {checked}"
+        );
+        // A direction away from the shape has density 0.
+        let ctx = ShapeSampleContext::from_point(c + Vec3::splat(5.0));
+        assert_eq!(shape.pdf_from(&ctx, Vec3::splat(1.0)).0, 0.0, "{name}");
+    }
+}
+
+/// Mean and standard error of E[1/pdf] over `n` solid-angle samples (misses count 0).
+fn mc_solid_angle(shape: &Shape, ctx: &ShapeSampleContext, n: usize, seed: u64) -> (f64, f64) {
+    let mut r = Pcg32::new(seed, 1);
+    let (mut s1, mut s2) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        let x = shape
+            .sample_from(ctx, u2(&mut r))
+            .map_or(0.0, |s| 1.0 / s.pdf.0 as f64);
+        s1 += x;
+        s2 += x * x;
+    }
+    let mean = s1 / n as f64;
+    let var = (s2 / n as f64 - mean * mean).max(0.0);
+    (mean, (var / n as f64).sqrt())
+}
+
+fn assert_within_5_sigma(name: &str, (mean, sigma): (f64, f64), exact: f64) {
+    let tol = 5.0 * sigma + 1e-5 * exact;
+    assert!(
+        (mean - exact).abs() <= tol,
+        "{name}: {mean} vs {exact} (σ = {sigma})"
+    );
+}
+
+#[test]
+fn solid_angle_estimates_match_closed_forms() {
+    let n = 100_000;
+    // Sphere seen from outside: 2π(1 − √(1 − r²/d²)); from inside: 4π.
+    let (c, rad) = (Vec3::new(1.0, -2.0, 0.5), 0.8);
+    let sphere = Shape::Sphere(Sphere::new(
+        similarity(rad, c),
+        false,
+        1.0,
+        -1.0,
+        1.0,
+        360.0,
+    ));
+    for d in [1.5f32, 4.0, 40.0] {
+        let ctx = ShapeSampleContext::from_point(c + Vec3::new(0.6, 0.0, 0.8) * d);
+        let exact =
+            2.0 * std::f64::consts::PI * (1.0 - (1.0 - (rad as f64 / d as f64).powi(2)).sqrt());
+        assert_within_5_sigma("sphere", mc_solid_angle(&sphere, &ctx, n, 1), exact);
+    }
+    let ctx = ShapeSampleContext::from_point(c + Vec3::new(0.1, 0.3, -0.2));
+    assert_within_5_sigma(
+        "sphere inside",
+        mc_solid_angle(&sphere, &ctx, n, 2),
+        4.0 * std::f64::consts::PI,
+    );
+
+    // Triangle: Van Oosterom & Strackee 1983.
+    let p = [
+        Vec3::new(0.3, -0.2, 2.0),
+        Vec3::new(1.4, 0.1, 2.6),
+        Vec3::new(0.2, 1.3, 2.2),
+    ];
+    let tri = Shape::Triangle(Triangle::new(
+        tri_mesh(p.to_vec(), vec![0, 1, 2], None, false),
+        0,
+    ));
+    for o in [Vec3::ZERO, Vec3::new(0.6, 0.4, 1.8)] {
+        let [a, b, cc] = p.map(|v| (v - o).as_dvec3());
+        let (la, lb, lc) = (a.length(), b.length(), cc.length());
+        let num = a.dot(b.cross(cc)).abs();
+        let den = la * lb * lc + a.dot(b) * lc + a.dot(cc) * lb + b.dot(cc) * la;
+        let exact = 2.0 * num.atan2(den);
+        let ctx = ShapeSampleContext::from_point(o);
+        assert_within_5_sigma("triangle", mc_solid_angle(&tri, &ctx, n, 3), exact);
+    }
+
+    // Disk seen off-axis: midpoint quadrature of ∫ cos θ / d² dA in polar coordinates.
+    let (h, rr) = (0.0f32, 1.0f32);
+    let disk = Shape::Disk(Disk::new(
+        Arc::new(Transform::IDENTITY),
+        false,
+        h,
+        rr,
+        0.0,
+        360.0,
+    ));
+    let o = DVec3::new(0.7, 0.4, 0.9);
+    let (nr, nphi) = (800, 800);
+    let mut exact = 0.0;
+    for i in 0..nr {
+        let r = (i as f64 + 0.5) / nr as f64 * rr as f64;
+        for j in 0..nphi {
+            let phi = (j as f64 + 0.5) / nphi as f64 * 2.0 * std::f64::consts::PI;
+            let q = DVec3::new(r * phi.cos(), r * phi.sin(), h as f64);
+            let d = o - q;
+            let da = r * (rr as f64 / nr as f64) * (2.0 * std::f64::consts::PI / nphi as f64);
+            exact += d.z.abs() / d.length().powi(3) * da;
+        }
+    }
+    let ctx = ShapeSampleContext::from_point(o.as_vec3());
+    assert_within_5_sigma("disk", mc_solid_angle(&disk, &ctx, n, 4), exact);
+}
