@@ -1,16 +1,22 @@
 //! candela-core: the rendering core of candela.
 //!
 //! A plain scene description (from `candela-scene`) is turned into a
-//! traceable scene, which the integrators render onto a film.
+//! traceable [`scene`] (shapes in a BVH, materials, lights), which an
+//! [`integrator`] renders onto a [`film`] through a [`camera`].
 
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod film;
+pub mod image;
+pub mod integrator;
 pub mod interaction;
 pub mod light;
+pub mod material;
 pub mod math;
 pub mod sampler;
 pub mod sampling;
+pub mod scene;
 pub mod shape;
 pub mod spectrum;
+pub mod texture;

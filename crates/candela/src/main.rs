@@ -1,2 +1,181 @@
-//! The `candela` command-line renderer.
-fn main() {}
+//! The `candela` command-line renderer: a thin layer over `candela-scene`
+//! (parsing) and `candela-core` (building and rendering).
+
+mod progress;
+
+use anyhow::{bail, Context, Result};
+use candela_core::image::{compare, RgbImage};
+use candela_core::integrator::RenderContext;
+use candela_core::scene::build::{build, Overrides};
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// candela: a spectral, physically based renderer for pbrt-v4 scenes.
+#[derive(Parser)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Render a pbrt-v4 scene to EXR (linear, float) and PNG (tone-mapped sRGB).
+    Render(RenderArgs),
+    /// Compare two EXR images: per-channel mean ratio, relMSE, MAE, worst 32×32 block.
+    Diff {
+        /// The image to check.
+        a: PathBuf,
+        /// The reference.
+        b: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene file (.pbrt, optionally .gz).
+    scene: PathBuf,
+    /// Samples per pixel (overrides the Sampler's "pixelsamples").
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Integrator name (overrides the Integrator directive).
+    #[arg(long)]
+    integrator: Option<String>,
+    /// Output EXR path (a PNG is written beside it).
+    #[arg(long)]
+    outfile: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    nthreads: Option<usize>,
+    /// Sampler seed (overrides the Sampler's "seed").
+    #[arg(long)]
+    seed: Option<u64>,
+    /// No progress bar or statistics.
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.cmd {
+        Cmd::Render(args) => render(args),
+        Cmd::Diff { a, b } => diff(&a, &b),
+    };
+    if let Err(e) = result {
+        eprintln!("candela: error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    if let Some(n) = args.nthreads {
+        if n == 0 {
+            bail!("--nthreads must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("setting up the thread pool")?;
+    }
+    let t0 = Instant::now();
+    let desc = candela_scene::parse_file(&args.scene)?;
+    let ov = Overrides {
+        spp: args.spp,
+        integrator: args.integrator.clone(),
+        outfile: args.outfile.clone(),
+        seed: args.seed,
+    };
+    let mut setup = build(&desc, &ov)?;
+    for w in &setup.warnings {
+        eprintln!("candela: warning: {w}");
+    }
+    let load_time = t0.elapsed();
+    let bar = progress::Bar::new(args.quiet);
+    let ctx = RenderContext {
+        scene: &setup.scene,
+        camera: &setup.camera,
+        sampler: &setup.sampler,
+        progress: &bar,
+    };
+    let t1 = Instant::now();
+    setup.integrator.render(&ctx, &mut setup.film);
+    let render_time = t1.elapsed();
+    let image = setup.film.image(1.0);
+    let exr = setup.outfile.clone();
+    write_outputs(&image, &exr)?;
+    if setup.film.dropped_samples() > 0 {
+        eprintln!(
+            "candela: warning: {} non-finite samples were dropped (a bug: please report)",
+            setup.film.dropped_samples()
+        );
+    }
+    if !args.quiet {
+        let m = image.channel_means();
+        eprintln!(
+            "candela: {} with {} spp: load {:.2} s, render {:.2} s; mean RGB {:.5} {:.5} {:.5}; wrote {}",
+            setup.integrator_name,
+            setup.sampler.samples_per_pixel(),
+            load_time.as_secs_f64(),
+            render_time.as_secs_f64(),
+            m[0],
+            m[1],
+            m[2],
+            exr.display()
+        );
+    }
+    Ok(())
+}
+
+/// Writes the EXR and a PNG beside it (same stem).
+fn write_outputs(image: &RgbImage, exr: &Path) -> Result<()> {
+    let exr = if exr
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        exr.to_path_buf()
+    } else if exr
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        exr.with_extension("exr")
+    } else {
+        bail!(
+            "output file {} must end in .exr (a .png is written beside it)",
+            exr.display()
+        );
+    };
+    if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    image.write_exr(&exr)?;
+    image.write_png(&exr.with_extension("png"), 0.0)?;
+    Ok(())
+}
+
+fn diff(a: &Path, b: &Path) -> Result<()> {
+    let ia = RgbImage::read_exr(a)?;
+    let ib = RgbImage::read_exr(b)?;
+    let c = compare(&ia, &ib)?;
+    let (ma, mb) = (ia.channel_means(), ib.channel_means());
+    println!(
+        "{:<10} {:>12} {:>12} {:>10}",
+        "channel", "mean A", "mean B", "A/B"
+    );
+    for (i, ch) in ["R", "G", "B"].iter().enumerate() {
+        println!(
+            "{:<10} {:>12.6} {:>12.6} {:>10.5}",
+            ch, ma[i], mb[i], c.mean_ratio[i]
+        );
+    }
+    println!("relMSE (eps 0.01)  {:.6}", c.rel_mse);
+    println!("MAE                {:.6}", c.mae);
+    let (r, bx, by) = c.worst_block;
+    println!(
+        "worst 32x32 block  {:.5} at block ({bx}, {by}) = pixels ({}, {})",
+        r,
+        bx * 32,
+        by * 32
+    );
+    Ok(())
+}

@@ -1,6 +1,7 @@
-//! The film: where camera-ray estimates are filtered into pixels.
-//!
-//! This module is shared: the pixel filters live in [`filter`]; the film
-//! itself is added by its owner.
+//! The film: where camera-ray estimates and light-tracing splats are
+//! filtered into pixels, and the pixel filters.
 
 pub mod filter;
+mod rgb_film;
+
+pub use rgb_film::{FilmSettings, FilmTile, RgbFilm};

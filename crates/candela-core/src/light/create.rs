@@ -22,12 +22,12 @@
 //! evident intent, k_e = 1 before the geometric factor. Renders with these
 //! values reproduce pbrt-v4's pixel values.
 
-use super::shape_stub::Shape;
 use super::{
     spectrum_photometric, DiffuseAreaLight, DistantLight, LightSpectrum, PointLight, SpotLight,
     UniformInfiniteLight,
 };
 use crate::math::{Frame, Mat4, Transform, Vec3, PI};
+use crate::shape::Shape;
 
 /// `scale / SpectrumToPhotometric(s)`: normalises `s` to one nit [pbrt-v4].
 fn nit_scale(scale: f32, s: &LightSpectrum) -> f32 {

@@ -13,13 +13,13 @@
 //! 1/2, so p_dir = cos θ/(2π). Then `β₀ = L·cos θ·A·π/cos θ = πAL = Φ`
 //! (2πAL two-sided) for every sample.
 
-use super::shape_stub::{Shape, ShapeSampleContext};
 use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::interaction::Interaction;
 use crate::math::{Frame, Vec2, Vec3, PI};
 use crate::sampling::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, PdfArea, PdfSolidAngle, ONE_MINUS_EPSILON,
 };
+use crate::shape::{Shape, ShapeSampleContext};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// A Lambertian emitter on a shape given in render space.

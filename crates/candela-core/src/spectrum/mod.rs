@@ -1,5 +1,48 @@
-//! Spectral representation: sampled spectra, spectrum functions, colour.
+//! Spectral representation: sampled spectra carried by paths, spectrum
+//! functions of wavelength, colour spaces and the camera sensor.
+//!
+//! Paths carry [`SampledSpectrum`] values at four wavelengths. Scene inputs
+//! become [`Spectrum`] functions: constants, measured tables (CIE
+//! illuminants), closed forms (Planck blackbody, Sellmeier glass) and RGB
+//! values lifted by the sigmoid-polynomial model of Jakob & Hanika 2019, as
+//! pbrt-v4 does (albedo, unbounded and illuminant kinds). The film turns
+//! sampled radiance into XYZ through the CIE 1931 2° observer.
 
+mod color;
+mod data;
+mod named;
+mod rgb2spec;
 mod sampled;
+mod spectra;
 
+pub use color::{ColorSpace, PixelSensor, Rgb, Xyz};
+pub use named::named_spectrum;
+pub use rgb2spec::RgbSigmoidPolynomial;
 pub use sampled::*;
+pub use spectra::{
+    inner_product, planck, spectrum_to_photometric, spectrum_to_xyz, PiecewiseLinear, Spectrum,
+};
+
+/// Σ ȳ(λ) over 360–830 nm at 1 nm: the normaliser of XYZ (pbrt-v4's `CIE_Y_integral`).
+pub const CIE_Y_INTEGRAL: f32 = 106.856_895;
+/// Maximum luminous efficacy [lm/W].
+pub const K_M: f32 = 683.0;
+
+/// CIE 1931 colour-matching functions at wavelength `lambda` [nm] (linear between 1 nm samples).
+pub fn cie_xyz(lambda: f32) -> [f32; 3] {
+    if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lambda) {
+        return [0.0; 3];
+    }
+    let x = lambda - LAMBDA_MIN;
+    let i = (x as usize).min(data::cie::CIE_X.len() - 2);
+    let t = x - i as f32;
+    let f = |a: &[f32; 471]| a[i] + t * (a[i + 1] - a[i]);
+    [
+        f(&data::cie::CIE_X),
+        f(&data::cie::CIE_Y),
+        f(&data::cie::CIE_Z),
+    ]
+}
+
+#[cfg(test)]
+mod tests;

@@ -16,7 +16,7 @@ use crate::sampling::Pcg32;
 
 /// Constant emission spectrum (the one place tests build spectra).
 pub(super) fn constant(v: f32) -> LightSpectrum {
-    LightSpectrum::Constant(v)
+    crate::spectrum::Spectrum::Constant(v)
 }
 
 /// Fixed wavelengths for tests.

@@ -1,0 +1,210 @@
+//! pbrt-v4's `rgb` film: per-pixel weighted sums of sensor RGB, converted to
+//! the output colour space (linear sRGB by default) when the image is read.
+//!
+//! A sample's spectral radiance L(λ) at the path's wavelengths is turned into
+//! sensor RGB by the pixel sensor (for the default `cie1931` sensor: the
+//! Monte Carlo estimate of XYZ times the imaging ratio), clamped to
+//! `maxcomponentvalue`, and added with its filter weight. Light-tracing
+//! splats go to a separate buffer that is scaled by 1/spp on output.
+
+use super::filter::Filter;
+use crate::image::RgbImage;
+use crate::math::{Mat3, UVec2, Vec3};
+use crate::spectrum::{PixelSensor, SampledSpectrum, SampledWavelengths};
+
+/// Film construction values (parsed from the `Film` directive).
+#[derive(Clone, Debug)]
+pub struct FilmSettings {
+    /// Full resolution in pixels.
+    pub resolution: UVec2,
+    /// Half-open pixel range actually rendered (crop window).
+    pub pixel_bounds: (UVec2, UVec2),
+    /// Samples whose largest sensor-RGB component exceeds this are scaled down (pbrt: +∞).
+    pub max_component_value: f32,
+}
+
+/// Weighted sum of samples in one pixel.
+#[derive(Clone, Copy, Debug, Default)]
+struct Pixel {
+    rgb_sum: [f64; 3],
+    weight_sum: f64,
+}
+
+/// The rgb film.
+#[derive(Clone, Debug)]
+pub struct RgbFilm {
+    settings: FilmSettings,
+    filter: Filter,
+    sensor: PixelSensor,
+    output_from_sensor: Mat3,
+    pixels: Vec<Pixel>,
+    splats: Vec<[f64; 3]>,
+    dropped_samples: u64,
+}
+
+/// The part of the film one thread renders; merged back with [`RgbFilm::merge_tile`].
+pub struct FilmTile {
+    lo: UVec2,
+    hi: UVec2,
+    pixels: Vec<Pixel>,
+    sensor: PixelSensor,
+    max_component_value: f32,
+    dropped_samples: u64,
+}
+
+impl RgbFilm {
+    /// New black film; `output_from_sensor` maps sensor RGB to output RGB.
+    pub fn new(
+        settings: FilmSettings,
+        filter: Filter,
+        sensor: PixelSensor,
+        output_from_sensor: Mat3,
+    ) -> Self {
+        let n = (settings.resolution.x * settings.resolution.y) as usize;
+        Self {
+            settings,
+            filter,
+            sensor,
+            output_from_sensor,
+            pixels: vec![Pixel::default(); n],
+            splats: vec![[0.0; 3]; n],
+            dropped_samples: 0,
+        }
+    }
+
+    /// Full resolution.
+    pub fn resolution(&self) -> UVec2 {
+        self.settings.resolution
+    }
+    /// Rendered pixel range.
+    pub fn pixel_bounds(&self) -> (UVec2, UVec2) {
+        self.settings.pixel_bounds
+    }
+    /// The pixel filter.
+    pub fn filter(&self) -> &Filter {
+        &self.filter
+    }
+    /// The pixel sensor.
+    pub fn sensor(&self) -> &PixelSensor {
+        &self.sensor
+    }
+    /// Samples discarded because they were NaN or infinite (should stay 0).
+    pub fn dropped_samples(&self) -> u64 {
+        self.dropped_samples
+    }
+
+    /// An empty tile covering `[lo, hi)`.
+    pub fn tile(&self, lo: UVec2, hi: UVec2) -> FilmTile {
+        let n = ((hi.x - lo.x) * (hi.y - lo.y)) as usize;
+        FilmTile {
+            lo,
+            hi,
+            pixels: vec![Pixel::default(); n],
+            sensor: self.sensor.clone(),
+            max_component_value: self.settings.max_component_value,
+            dropped_samples: 0,
+        }
+    }
+
+    /// Adds a finished tile's sums.
+    pub fn merge_tile(&mut self, tile: FilmTile) {
+        let w = tile.hi.x - tile.lo.x;
+        for y in tile.lo.y..tile.hi.y {
+            for x in tile.lo.x..tile.hi.x {
+                let src = tile.pixels[((y - tile.lo.y) * w + (x - tile.lo.x)) as usize];
+                let dst = &mut self.pixels[(y * self.settings.resolution.x + x) as usize];
+                for c in 0..3 {
+                    dst.rgb_sum[c] += src.rgb_sum[c];
+                }
+                dst.weight_sum += src.weight_sum;
+            }
+        }
+        self.dropped_samples += tile.dropped_samples;
+    }
+
+    /// Adds an unfiltered splat (light tracing) at raster position `p`.
+    pub fn add_splat(
+        &mut self,
+        p: crate::math::Vec2,
+        l: SampledSpectrum,
+        lambda: &SampledWavelengths,
+    ) {
+        if l.has_non_finite() {
+            self.dropped_samples += 1;
+            return;
+        }
+        let (lo, hi) = self.settings.pixel_bounds;
+        let (x, y) = (p.x.floor(), p.y.floor());
+        if x < lo.x as f32 || y < lo.y as f32 || x >= hi.x as f32 || y >= hi.y as f32 {
+            return;
+        }
+        let rgb = clamp_rgb(
+            self.sensor.to_sensor_rgb(l, lambda),
+            self.settings.max_component_value,
+        );
+        let s = &mut self.splats[(y as u32 * self.settings.resolution.x + x as u32) as usize];
+        for c in 0..3 {
+            s[c] += rgb[c] as f64;
+        }
+    }
+
+    /// The image in output RGB over the pixel bounds; splats are scaled by `splat_scale`.
+    pub fn image(&self, splat_scale: f64) -> RgbImage {
+        let (lo, hi) = self.settings.pixel_bounds;
+        let mut img = RgbImage::new((hi.x - lo.x) as usize, (hi.y - lo.y) as usize);
+        for y in lo.y..hi.y {
+            for x in lo.x..hi.x {
+                let i = (y * self.settings.resolution.x + x) as usize;
+                let p = self.pixels[i];
+                let mut rgb = [0.0f64; 3];
+                if p.weight_sum != 0.0 {
+                    rgb = p.rgb_sum.map(|v| v / p.weight_sum);
+                }
+                for c in 0..3 {
+                    rgb[c] += splat_scale * self.splats[i][c];
+                }
+                let out = self.output_from_sensor
+                    * Vec3::new(rgb[0] as f32, rgb[1] as f32, rgb[2] as f32);
+                img.pixels[((y - lo.y) as usize) * img.width + (x - lo.x) as usize] =
+                    out.to_array();
+            }
+        }
+        img
+    }
+}
+
+fn clamp_rgb(rgb: [f32; 3], max_component: f32) -> [f32; 3] {
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m > max_component {
+        rgb.map(|v| v * max_component / m)
+    } else {
+        rgb
+    }
+}
+
+impl FilmTile {
+    /// Adds one camera sample of radiance `l` with filter weight `weight`.
+    /// Non-finite samples are dropped and counted, never written.
+    pub fn add_sample(
+        &mut self,
+        pixel: UVec2,
+        l: SampledSpectrum,
+        lambda: &SampledWavelengths,
+        weight: f32,
+    ) {
+        if l.has_non_finite() || !weight.is_finite() {
+            self.dropped_samples += 1;
+            return;
+        }
+        let rgb = clamp_rgb(
+            self.sensor.to_sensor_rgb(l, lambda),
+            self.max_component_value,
+        );
+        let w = self.hi.x - self.lo.x;
+        let p = &mut self.pixels[((pixel.y - self.lo.y) * w + (pixel.x - self.lo.x)) as usize];
+        for c in 0..3 {
+            p.rgb_sum[c] += (weight * rgb[c]) as f64;
+        }
+        p.weight_sum += weight as f64;
+    }
+}

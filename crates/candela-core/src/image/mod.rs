@@ -1,0 +1,168 @@
+//! RGB float images: EXR and PNG files, and the comparison metrics of
+//! `candela diff` (validation.md, "Image metrics").
+
+mod compare;
+
+pub use compare::{compare, Comparison};
+
+use std::path::Path;
+use thiserror::Error;
+
+/// Failure reading or writing an image file.
+#[derive(Debug, Error)]
+pub enum ImageError {
+    /// The EXR codec failed.
+    #[error("{path}: {source}")]
+    Exr {
+        /// File.
+        path: String,
+        /// Cause.
+        source: exr::error::Error,
+    },
+    /// The PNG codec failed.
+    #[error("{path}: {source}")]
+    Png {
+        /// File.
+        path: String,
+        /// Cause.
+        source: image::ImageError,
+    },
+    /// The two images cannot be compared.
+    #[error("image sizes differ: {0}x{1} vs {2}x{3}")]
+    SizeMismatch(usize, usize, usize, usize),
+}
+
+/// A linear RGB image, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `width·height` RGB triples.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl RgbImage {
+    /// Black image.
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; width * height],
+        }
+    }
+
+    /// Pixel at (x, y).
+    #[inline]
+    pub fn get(&self, x: usize, y: usize) -> [f32; 3] {
+        self.pixels[y * self.width + x]
+    }
+
+    /// Reads the first RGB(A) layer of an EXR file (any sample type).
+    pub fn read_exr(path: &Path) -> Result<Self, ImageError> {
+        use exr::prelude::*;
+        let img = read_first_rgba_layer_from_file(
+            path,
+            |res, _| RgbImage::new(res.width(), res.height()),
+            |img: &mut RgbImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                let w = img.width;
+                img.pixels[pos.y() * w + pos.x()] = [r, g, b];
+            },
+        )
+        .map_err(|source| ImageError::Exr {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Ok(img.layer_data.channel_data.pixels)
+    }
+
+    /// Writes a 32-bit float RGB EXR.
+    pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
+        exr::prelude::write_rgb_file(path, self.width, self.height, |x, y| {
+            let p = self.get(x, y);
+            (p[0], p[1], p[2])
+        })
+        .map_err(|source| ImageError::Exr {
+            path: path.display().to_string(),
+            source,
+        })
+    }
+
+    /// Writes an 8-bit sRGB PNG: linear values scaled by 2^`stops`, clipped
+    /// to [0, 1] and encoded with the sRGB transfer curve.
+    pub fn write_png(&self, path: &Path, stops: f32) -> Result<(), ImageError> {
+        let scale = 2f32.powf(stops);
+        let mut buf = Vec::with_capacity(self.width * self.height * 3);
+        for p in &self.pixels {
+            for &c in p {
+                buf.push((srgb_encode(c * scale) * 255.0 + 0.5) as u8);
+            }
+        }
+        image::save_buffer(
+            path,
+            &buf,
+            self.width as u32,
+            self.height as u32,
+            image::ColorType::Rgb8,
+        )
+        .map_err(|source| ImageError::Png {
+            path: path.display().to_string(),
+            source,
+        })
+    }
+
+    /// Mean of each channel.
+    pub fn channel_means(&self) -> [f64; 3] {
+        let mut s = [0.0f64; 3];
+        for p in &self.pixels {
+            for c in 0..3 {
+                s[c] += p[c] as f64;
+            }
+        }
+        let n = self.pixels.len().max(1) as f64;
+        s.map(|v| v / n)
+    }
+}
+
+/// sRGB opto-electronic transfer function of a linear value, clipped to [0, 1].
+pub fn srgb_encode(v: f32) -> f32 {
+    let v = if v.is_finite() {
+        v.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_is_exact() {
+        let mut img = RgbImage::new(5, 3);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            *p = [i as f32 * 0.25, 1e-7 * i as f32, 1e6 + i as f32];
+        }
+        let dir = std::env::temp_dir().join(format!("candela-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.exr");
+        img.write_exr(&path).unwrap();
+        assert_eq!(RgbImage::read_exr(&path).unwrap(), img);
+        img.write_png(&dir.join("t.png"), 0.0).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn srgb_curve_endpoints() {
+        assert_eq!(srgb_encode(0.0), 0.0);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
+        assert!((srgb_encode(0.18) - 0.4614).abs() < 1e-3);
+        assert_eq!(srgb_encode(f32::NAN), 0.0);
+    }
+}

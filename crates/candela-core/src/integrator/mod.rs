@@ -1,0 +1,67 @@
+//! Integrators: estimators of the measurement equation.
+//!
+//! Every integrator implements [`Integrator`]. Camera-driven ones implement
+//! [`PixelEstimator`] and share the tiled driver in [`driver`], which owns
+//! threads, tiles, progress and deterministic accumulation (Tungsten's split
+//! of driver / per-path tracer / settings).
+
+pub mod driver;
+mod path;
+
+pub use path::{PathIntegrator, PathSettings};
+
+use crate::camera::Camera;
+use crate::film::RgbFilm;
+use crate::math::Ray;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// Progress reporting from the render loop (thread-safe).
+pub trait Progress: Sync {
+    /// Called with the total amount of work before rendering starts.
+    fn start(&self, total: u64, unit: &str);
+    /// Called as work completes.
+    fn advance(&self, done: u64);
+    /// Called once at the end.
+    fn finish(&self);
+}
+
+/// A progress sink that ignores everything.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn start(&self, _total: u64, _unit: &str) {}
+    fn advance(&self, _done: u64) {}
+    fn finish(&self) {}
+}
+
+/// What every render needs besides the integrator.
+pub struct RenderContext<'a> {
+    /// The traceable scene.
+    pub scene: &'a Scene,
+    /// The camera.
+    pub camera: &'a Camera,
+    /// The prototype sampler (cloned per tile; fixes spp and seed).
+    pub sampler: &'a Sampler,
+    /// Progress sink.
+    pub progress: &'a dyn Progress,
+}
+
+/// A light transport algorithm.
+pub trait Integrator: Send + Sync {
+    /// Renders the scene onto `film`.
+    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm);
+}
+
+/// A camera-driven estimator: the radiance arriving along one camera ray.
+pub trait PixelEstimator: Send + Sync {
+    /// Estimates the incident radiance along `ray` for the wavelengths `lambda`.
+    fn li(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum;
+}

@@ -1,0 +1,242 @@
+//! Unidirectional path tracing with next-event estimation and multiple
+//! importance sampling [Veach 1997, ch. 9; pbrt-v4 §13.4].
+//!
+//! At every non-specular vertex the estimator combines two strategies for
+//! direct light: a light sample (NEE) and the continuation BSDF sample that
+//! happens to hit an emitter, weighted by the power heuristic (β = 2,
+//! [Veach 1997, eq. 9.13]). Delta lights and specular bounces have a single
+//! strategy and weight 1. Paths end by Russian roulette on the throughput
+//! (corrected by the accumulated η² so refraction does not bias it, as pbrt-v4)
+//! or at `maxdepth` scattering events.
+
+use super::{driver, Integrator, PixelEstimator, RenderContext};
+use crate::bsdf::{BsdfSample, SampleFlags, TransportMode};
+use crate::film::RgbFilm;
+use crate::interaction::SurfaceInteraction;
+use crate::light::{LightSampleContext, LightType};
+use crate::math::Ray;
+use crate::sampler::Sampler;
+use crate::sampling::power_heuristic;
+use crate::scene::Scene;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// Parameters of `Integrator "path"`.
+#[derive(Clone, Debug)]
+pub struct PathSettings {
+    /// Maximum number of scattering events (pbrt-v4 default 5).
+    pub max_depth: u32,
+    /// Roughen near-specular lobes after the first non-specular bounce (biased; off by default).
+    pub regularize: bool,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        Self {
+            max_depth: 5,
+            regularize: false,
+        }
+    }
+}
+
+/// The path tracer.
+pub struct PathIntegrator {
+    /// Settings.
+    pub settings: PathSettings,
+}
+
+impl Integrator for PathIntegrator {
+    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
+        driver::render_pixels(self, ctx, film);
+    }
+}
+
+/// State carried from one path vertex to the next.
+struct PathState {
+    l: SampledSpectrum,
+    beta: SampledSpectrum,
+    depth: u32,
+    specular_bounce: bool,
+    any_non_specular: bool,
+    /// Solid-angle density of the last BSDF sample (for MIS on emitter hits).
+    prev_pdf: f32,
+    /// Where the last BSDF sample left from.
+    prev_ctx: LightSampleContext,
+    /// Product of η² over refractions, to undo radiance scaling in roulette.
+    eta_scale: f32,
+}
+
+impl PixelEstimator for PathIntegrator {
+    fn li(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
+        let mut st = PathState {
+            l: SampledSpectrum::zero(),
+            beta: SampledSpectrum::one(),
+            depth: 0,
+            specular_bounce: false,
+            any_non_specular: false,
+            prev_pdf: 0.0,
+            prev_ctx: LightSampleContext::at_point(ray.o),
+            eta_scale: 1.0,
+        };
+        loop {
+            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+                self.add_infinite_light(scene, &ray, lambda, &mut st);
+                break;
+            };
+            self.add_surface_emission(scene, &si, lambda, &mut st);
+            let Some(mut bsdf) = scene.bsdf(&si, lambda) else {
+                // Interface material: continue straight through, not a scattering event.
+                st.specular_bounce = true;
+                ray = si.spawn_ray(ray.d);
+                continue;
+            };
+            if st.depth == self.settings.max_depth {
+                break;
+            }
+            st.depth += 1;
+            if self.settings.regularize && st.any_non_specular {
+                bsdf.regularize();
+            }
+            let wo = -ray.d.normalize();
+            if bsdf.flags().is_non_specular() {
+                st.l += st.beta * self.sample_direct(scene, &si, &bsdf, wo, lambda, sampler);
+            }
+            let Some(bs) = bsdf.sample_f(
+                wo,
+                sampler.get_1d(),
+                sampler.get_2d(),
+                TransportMode::Radiance,
+                SampleFlags::ALL,
+            ) else {
+                break;
+            };
+            self.scatter(&si, &bs, &mut st);
+            ray = si.spawn_ray(bs.wi);
+            if !self.russian_roulette(&mut st, sampler) {
+                break;
+            }
+        }
+        st.l
+    }
+}
+
+impl PathIntegrator {
+    /// Radiance from infinite lights seen along an escaping ray, MIS-weighted.
+    fn add_infinite_light(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        lambda: &SampledWavelengths,
+        st: &mut PathState,
+    ) {
+        for &id in scene.infinite_lights() {
+            let light = scene.light(id);
+            let le = light.le(ray, lambda);
+            if le.is_black() {
+                continue;
+            }
+            if st.depth == 0 || st.specular_bounce {
+                st.l += st.beta * le;
+            } else {
+                let p_light =
+                    scene.light_sampler().pmf(id) * light.pdf_li(&st.prev_ctx, ray.d.normalize()).0;
+                st.l += st.beta * le * power_heuristic(1.0, st.prev_pdf, 1.0, p_light);
+            }
+        }
+    }
+
+    /// Radiance emitted by an area light the path hits, MIS-weighted against NEE.
+    fn add_surface_emission(
+        &self,
+        scene: &Scene,
+        si: &SurfaceInteraction,
+        lambda: &SampledWavelengths,
+        st: &mut PathState,
+    ) {
+        let Some(id) = si.area_light else { return };
+        let light = scene.light(id);
+        let le = light.l(si.p(), si.n(), si.it.uv, si.wo, lambda);
+        if le.is_black() {
+            return;
+        }
+        if st.depth == 0 || st.specular_bounce {
+            st.l += st.beta * le;
+        } else {
+            let p_light = scene.light_sampler().pmf(id) * light.pdf_li(&st.prev_ctx, -si.wo).0;
+            st.l += st.beta * le * power_heuristic(1.0, st.prev_pdf, 1.0, p_light);
+        }
+    }
+
+    /// Next-event estimation: one light sample, MIS-weighted against BSDF sampling.
+    fn sample_direct(
+        &self,
+        scene: &Scene,
+        si: &SurfaceInteraction,
+        bsdf: &crate::bsdf::Bsdf,
+        wo: crate::math::Vec3,
+        lambda: &SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
+        let ctx = LightSampleContext::from_surface(si);
+        let u_light = sampler.get_1d();
+        let u = sampler.get_2d();
+        let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
+            return SampledSpectrum::zero();
+        };
+        let light = scene.light(id);
+        let Some(ls) = light.sample_li(&ctx, u, lambda) else {
+            return SampledSpectrum::zero();
+        };
+        if ls.l.is_black() || ls.pdf.0 == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(bsdf.ns()).abs();
+        if f.is_black() || !scene.unoccluded(&si.it, &ls.p_light) {
+            return SampledSpectrum::zero();
+        }
+        let p_l = pmf * ls.pdf.0;
+        if matches!(
+            light.light_type(),
+            LightType::DeltaPosition | LightType::DeltaDirection
+        ) {
+            return f * ls.l / p_l;
+        }
+        let p_bsdf = bsdf
+            .pdf(wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
+            .0;
+        f * ls.l * (power_heuristic(1.0, p_l, 1.0, p_bsdf) / p_l)
+    }
+
+    /// Updates throughput and MIS state after a BSDF sample.
+    fn scatter(&self, si: &SurfaceInteraction, bs: &BsdfSample, st: &mut PathState) {
+        st.beta *= bs.f * (bs.wi.dot(si.shading.n).abs() / bs.pdf.0);
+        st.prev_pdf = bs.pdf.0;
+        st.specular_bounce = bs.is_specular();
+        st.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            st.eta_scale *= bs.eta * bs.eta;
+        }
+        st.prev_ctx = LightSampleContext::from_surface(si);
+    }
+
+    /// Russian roulette after the first bounces; returns false to stop.
+    fn russian_roulette(&self, st: &mut PathState, sampler: &mut Sampler) -> bool {
+        if st.beta.is_black() {
+            return false;
+        }
+        let rr_beta = (st.beta * st.eta_scale).max_component();
+        if rr_beta < 1.0 && st.depth > 1 {
+            let q = (1.0 - rr_beta).max(0.0);
+            if sampler.get_1d() < q {
+                return false;
+            }
+            st.beta /= 1.0 - q;
+        }
+        true
+    }
+}

@@ -1,0 +1,168 @@
+//! Description → render setup: turns the parser's plain entities into
+//! cameras, films, samplers, materials, shapes, lights and an integrator,
+//! with pbrt-v4's parameter names and defaults.
+//!
+//! Everything not supported is an error naming the entity and its
+//! file:line:col; parameters nobody looked at become warnings.
+
+mod entities;
+mod geometry;
+mod lights;
+mod spectra;
+
+use crate::camera::Camera;
+use crate::film::RgbFilm;
+use crate::integrator::Integrator;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+use candela_scene::{Entity, Loc, ParamSet, SceneDescription, SceneError};
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// A scene that cannot be built.
+#[derive(Debug, Error)]
+pub enum BuildError {
+    /// A problem at a place in the scene file.
+    #[error("{loc}: {msg}")]
+    At {
+        /// Where.
+        loc: Loc,
+        /// What was expected or is unsupported.
+        msg: String,
+    },
+    /// A problem without a location.
+    #[error("{0}")]
+    Other(String),
+    /// A parameter access failed (wrong type, missing file, …).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+impl BuildError {
+    /// Error at a location.
+    pub fn at(loc: &Loc, msg: impl Into<String>) -> Self {
+        BuildError::At {
+            loc: loc.clone(),
+            msg: msg.into(),
+        }
+    }
+}
+
+/// A directive the scene did not give, with pbrt-v4's defaults.
+fn default_entity(name: &str) -> Entity {
+    Entity {
+        name: name.to_string(),
+        params: ParamSet::default(),
+        color_space: "srgb".to_string(),
+        loc: Loc::file_only(std::path::Path::new("<default>")),
+    }
+}
+
+/// Command-line values that override the scene file, like pbrt-v4's flags.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// `--spp`.
+    pub spp: Option<u32>,
+    /// `--integrator`.
+    pub integrator: Option<String>,
+    /// `--outfile`.
+    pub outfile: Option<PathBuf>,
+    /// `--seed`.
+    pub seed: Option<u64>,
+}
+
+/// Everything needed to render.
+pub struct RenderSetup {
+    /// The traceable scene.
+    pub scene: Scene,
+    /// The camera.
+    pub camera: Camera,
+    /// The film.
+    pub film: RgbFilm,
+    /// The prototype sampler.
+    pub sampler: Sampler,
+    /// The light transport algorithm.
+    pub integrator: Box<dyn Integrator>,
+    /// Name of the integrator.
+    pub integrator_name: String,
+    /// Output image path.
+    pub outfile: PathBuf,
+    /// Non-fatal problems (unused parameters, substitutions).
+    pub warnings: Vec<String>,
+}
+
+/// Builds the render setup.
+pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, BuildError> {
+    let mut warnings: Vec<String> = desc
+        .warnings
+        .iter()
+        .map(|w| format!("{}: {}", w.loc, w.message))
+        .collect();
+    let (film, outfile) = entities::film(desc, ov)?;
+    let camera = entities::camera(desc, &film)?;
+    let sampler = entities::sampler(desc, ov, &mut warnings)?;
+    let (integrator, integrator_name, power_sampling) =
+        entities::integrator(desc, ov, &mut warnings)?;
+    let materials = geometry::materials(desc)?;
+    let (primitives, mut lights) = geometry::primitives(desc, &materials.1)?;
+    lights.extend(lights::lights(desc)?);
+    let scene = Scene::new(primitives, materials.0, lights, power_sampling);
+    collect_unused(desc, &mut warnings);
+    Ok(RenderSetup {
+        scene,
+        camera,
+        film,
+        sampler,
+        integrator,
+        integrator_name,
+        outfile,
+        warnings,
+    })
+}
+
+fn unused_of(params: &ParamSet, what: &str, warnings: &mut Vec<String>) {
+    for (name, loc) in params.unused() {
+        warnings.push(format!("{loc}: unused parameter \"{name}\" of {what}"));
+    }
+}
+
+/// Reports every parameter that no builder looked at.
+fn collect_unused(desc: &SceneDescription, warnings: &mut Vec<String>) {
+    for (e, what) in [
+        (&desc.film, "Film"),
+        (&desc.sampler, "Sampler"),
+        (&desc.integrator, "Integrator"),
+        (&desc.filter, "PixelFilter"),
+    ] {
+        if let Some(e) = e {
+            unused_of(&e.params, &format!("{what} \"{}\"", e.name), warnings);
+        }
+    }
+    if let Some(c) = &desc.camera {
+        unused_of(&c.params, &format!("Camera \"{}\"", c.name), warnings);
+    }
+    for m in desc
+        .materials
+        .iter()
+        .chain(desc.named_materials.iter().map(|(_, m)| m))
+    {
+        unused_of(&m.params, &format!("Material \"{}\"", m.ty), warnings);
+    }
+    for s in desc.shapes.iter().chain(
+        desc.instance_definitions
+            .iter()
+            .flat_map(|d| d.shapes.iter()),
+    ) {
+        unused_of(&s.params, &format!("Shape \"{}\"", s.name), warnings);
+        if let Some(a) = &s.area_light {
+            unused_of(
+                &a.params,
+                &format!("AreaLightSource \"{}\"", a.name),
+                warnings,
+            );
+        }
+    }
+    for l in &desc.lights {
+        unused_of(&l.params, &format!("LightSource \"{}\"", l.name), warnings);
+    }
+}

@@ -1,0 +1,275 @@
+//! Camera, film, pixel filter, sampler and integrator from their directives.
+
+use super::{BuildError, Overrides};
+use crate::camera::{Camera, CameraParams};
+use crate::film::filter::{Filter, FilterKind, FilterParams};
+use crate::film::{FilmSettings, RgbFilm};
+use crate::integrator::{Integrator, PathIntegrator, PathSettings};
+use crate::math::{Transform, UVec2, Vec2};
+use crate::sampler::{Sampler, SamplerKind};
+use crate::spectrum::{ColorSpace, PixelSensor};
+use candela_scene::SceneDescription;
+use std::path::PathBuf;
+
+fn transform(
+    rows: &candela_scene::Mat4d,
+    loc: &candela_scene::Loc,
+) -> Result<Transform, BuildError> {
+    Transform::from_rows_f64(rows.m)
+        .ok_or_else(|| BuildError::at(loc, "singular transformation matrix"))
+}
+
+/// The film and the output path (`--outfile` over `"string filename"`).
+pub fn film(desc: &SceneDescription, ov: &Overrides) -> Result<(RgbFilm, PathBuf), BuildError> {
+    let empty = super::default_entity("rgb");
+    let e = desc.film.as_ref().unwrap_or(&empty);
+    if e.name != "rgb" {
+        return Err(BuildError::at(
+            &e.loc,
+            format!(
+                "film \"{}\" is not supported yet (supported: \"rgb\")",
+                e.name
+            ),
+        ));
+    }
+    let p = &e.params;
+    let res = UVec2::new(
+        p.get_int("xresolution", 1280)?.max(1) as u32,
+        p.get_int("yresolution", 720)?.max(1) as u32,
+    );
+    let filename = p.get_string("filename", "pbrt.exr")?;
+    let outfile = ov
+        .outfile
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(filename));
+    let pixel_bounds = pixel_bounds(p, res, &e.loc)?;
+    let max_component_value = p.get_float("maxcomponentvalue", f32::INFINITY)?;
+    let _ = p.get_bool("savefp16", true)?; // candela always writes 32-bit float EXR.
+    let iso = p.get_float("iso", 100.0)?;
+    let exposure_time = camera_exposure(desc)?;
+    let sensor_name = p.get_string("sensor", "cie1931")?;
+    if sensor_name != "cie1931" {
+        return Err(BuildError::at(
+            &e.loc,
+            format!("sensor \"{sensor_name}\" is not supported yet (supported: \"cie1931\")"),
+        ));
+    }
+    let white_balance = p.get_float("whitebalance", 0.0)?;
+    if white_balance != 0.0 {
+        return Err(BuildError::at(
+            &e.loc,
+            "\"whitebalance\" is not supported yet",
+        ));
+    }
+    let cs = ColorSpace::by_name(&e.color_space).ok_or_else(|| {
+        BuildError::at(&e.loc, format!("unknown color space \"{}\"", e.color_space))
+    })?;
+    let sensor = PixelSensor::cie1931(exposure_time * iso / 100.0);
+    let output_from_sensor = cs.rgb_from_xyz * sensor.xyz_from_sensor_rgb();
+    let filter = filter(desc)?;
+    let settings = FilmSettings {
+        resolution: res,
+        pixel_bounds,
+        max_component_value,
+    };
+    Ok((
+        RgbFilm::new(settings, filter, sensor, output_from_sensor),
+        outfile,
+    ))
+}
+
+fn camera_exposure(desc: &SceneDescription) -> Result<f32, BuildError> {
+    let Some(c) = &desc.camera else {
+        return Ok(1.0);
+    };
+    let open = c.params.get_float("shutteropen", 0.0)?;
+    let close = c.params.get_float("shutterclose", 1.0)?;
+    if close < open {
+        return Err(BuildError::at(
+            &c.loc,
+            "\"shutterclose\" is before \"shutteropen\"",
+        ));
+    }
+    Ok(close - open)
+}
+
+/// Crop window / pixel bounds as pbrt-v4 computes them (half-open pixel range).
+fn pixel_bounds(
+    p: &candela_scene::ParamSet,
+    res: UVec2,
+    loc: &candela_scene::Loc,
+) -> Result<(UVec2, UVec2), BuildError> {
+    if let Some(pb) = p.get_ints("pixelbounds")? {
+        if pb.len() != 4
+            || pb[0] < 0
+            || pb[2] < 0
+            || pb[1] <= pb[0]
+            || pb[3] <= pb[2]
+            || pb[1] as u32 > res.x
+            || pb[3] as u32 > res.y
+        {
+            return Err(BuildError::at(
+                loc,
+                "\"pixelbounds\" must be 4 integers x0 x1 y0 y1 inside the image",
+            ));
+        }
+        return Ok((
+            UVec2::new(pb[0] as u32, pb[2] as u32),
+            UVec2::new(pb[1] as u32, pb[3] as u32),
+        ));
+    }
+    if let Some(cw) = p.get_floats("cropwindow")? {
+        if cw.len() != 4 || cw[0] >= cw[1] || cw[2] >= cw[3] {
+            return Err(BuildError::at(
+                loc,
+                "\"cropwindow\" must be 4 floats x0 x1 y0 y1 with x0 < x1, y0 < y1",
+            ));
+        }
+        let c = |v: f32, r: u32| ((v.clamp(0.0, 1.0) * r as f32).ceil() as u32).min(r);
+        let lo = UVec2::new(c(cw[0], res.x), c(cw[2], res.y));
+        let hi = UVec2::new(c(cw[1], res.x), c(cw[3], res.y))
+            .max(lo + UVec2::ONE)
+            .min(res);
+        return Ok((lo, hi));
+    }
+    Ok((UVec2::ZERO, res))
+}
+
+/// The pixel filter (pbrt-v4's default is a Gaussian of radius 1.5, σ 0.5).
+fn filter(desc: &SceneDescription) -> Result<Filter, BuildError> {
+    let Some(e) = &desc.filter else {
+        return Ok(Filter::default());
+    };
+    let p = &e.params;
+    let kind = FilterKind::from_name(&e.name).ok_or_else(|| {
+        BuildError::at(
+            &e.loc,
+            format!(
+                "unknown pixel filter \"{}\" (known: box, gaussian, mitchell, sinc, triangle)",
+                e.name
+            ),
+        )
+    })?;
+    let opt = |name: &str| -> Result<Option<f32>, BuildError> {
+        Ok(p.get_floats(name)?.and_then(|v| v.first().copied()))
+    };
+    let (xr, yr) = (opt("xradius")?, opt("yradius")?);
+    let mut fp = FilterParams {
+        sigma: opt("sigma")?,
+        b: opt("B")?,
+        c: opt("C")?,
+        tau: opt("tau")?,
+        ..Default::default()
+    };
+    if xr.is_some() || yr.is_some() {
+        let def = Filter::new(kind, &FilterParams::default()).radius();
+        fp.radius = Some(Vec2::new(xr.unwrap_or(def.x), yr.unwrap_or(def.y)));
+    }
+    Ok(Filter::new(kind, &fp))
+}
+
+/// The camera.
+pub fn camera(desc: &SceneDescription, film: &RgbFilm) -> Result<Camera, BuildError> {
+    let Some(c) = &desc.camera else {
+        let params = CameraParams::new(Transform::IDENTITY, film.resolution());
+        return Camera::perspective(&params).map_err(|e| BuildError::Other(e.to_string()));
+    };
+    let p = &c.params;
+    let mut params = CameraParams::new(transform(&c.camera_from_world, &c.loc)?, film.resolution());
+    params.lens_radius = p.get_float("lensradius", 0.0)?;
+    params.focal_distance = p.get_float("focaldistance", 1e6)?;
+    if let Some(sw) = p.get_floats("screenwindow")? {
+        if sw.len() != 4 {
+            return Err(BuildError::at(&c.loc, "\"screenwindow\" needs 4 values"));
+        }
+        params.screen_window = Some([sw[0], sw[1], sw[2], sw[3]]);
+    }
+    params.filter_radius = film.filter().radius();
+    let cam = match c.name.as_str() {
+        "perspective" => {
+            params.fov_deg = p.get_float("fov", 90.0)?;
+            Camera::perspective(&params)
+        }
+        "orthographic" => Camera::orthographic(&params),
+        other => return Err(BuildError::at(
+            &c.loc,
+            format!(
+                "camera \"{other}\" is not supported yet (supported: perspective, orthographic)"
+            ),
+        )),
+    };
+    cam.map_err(|e| BuildError::at(&c.loc, e.to_string()))
+}
+
+/// The sampler; unknown pbrt samplers are substituted with a warning.
+pub fn sampler(
+    desc: &SceneDescription,
+    ov: &Overrides,
+    warnings: &mut Vec<String>,
+) -> Result<Sampler, BuildError> {
+    let empty = super::default_entity("zsobol");
+    let e = desc.sampler.as_ref().unwrap_or(&empty);
+    let mut spp = e.params.get_int("pixelsamples", 16)?.max(1) as u32;
+    if e.name == "stratified" {
+        // pbrt-v4's stratified sampler takes x/y counts instead of pixelsamples.
+        let (x, y) = (
+            e.params.get_int("xsamples", 4)?,
+            e.params.get_int("ysamples", 4)?,
+        );
+        let _ = e.params.get_bool("jitter", true)?;
+        spp = (x * y).max(1) as u32;
+    }
+    let spp = ov.spp.unwrap_or(spp);
+    let seed = match ov.seed {
+        Some(s) => s,
+        None => e.params.get_int("seed", 0)? as u64,
+    };
+    let (kind, exact) = SamplerKind::from_name(&e.name)
+        .ok_or_else(|| BuildError::at(&e.loc, format!("unknown sampler \"{}\"", e.name)))?;
+    if !exact {
+        warnings.push(format!(
+            "{}: sampler \"{}\" is not implemented; using {:?} (same expectation, different noise)",
+            e.loc, e.name, kind
+        ));
+    }
+    Ok(Sampler::new(kind, spp, seed))
+}
+
+/// The integrator; returns it, its name and whether lights are sampled by power.
+pub fn integrator(
+    desc: &SceneDescription,
+    ov: &Overrides,
+    warnings: &mut Vec<String>,
+) -> Result<(Box<dyn Integrator>, String, bool), BuildError> {
+    let empty = super::default_entity("volpath");
+    let e = desc.integrator.as_ref().unwrap_or(&empty);
+    let name = ov.integrator.clone().unwrap_or_else(|| e.name.clone());
+    let p = &e.params;
+    let max_depth = p.get_int("maxdepth", 5)?.max(0) as u32;
+    let regularize = p.get_bool("regularize", false)?;
+    let power = match p.get_string("lightsampler", "bvh")?.as_str() {
+        "uniform" => false,
+        "power" | "bvh" => true,
+        other => {
+            return Err(BuildError::at(
+                &e.loc,
+                format!("unknown light sampler \"{other}\""),
+            ))
+        }
+    };
+    match name.as_str() {
+        "path" => {}
+        "volpath" => warnings.push(format!(
+            "{}: integrator \"volpath\" rendered with \"path\" (participating media are not supported yet; identical without media)",
+            e.loc
+        )),
+        other => {
+            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath)")));
+        }
+    }
+    let settings = PathSettings {
+        max_depth,
+        regularize,
+    };
+    Ok((Box::new(PathIntegrator { settings }), name, power))
+}

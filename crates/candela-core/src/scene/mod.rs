@@ -1,0 +1,127 @@
+//! The traceable scene: primitives in a BVH, materials, lights and the
+//! light sampler. Built from a plain description by [`build`].
+
+pub mod build;
+mod primitive;
+
+pub use primitive::Primitive;
+
+use crate::accel::Bvh;
+use crate::bsdf::Bsdf;
+use crate::interaction::{Interaction, LightId, SurfaceInteraction};
+use crate::light::{Light, LightSampler};
+use crate::material::Material;
+use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
+use crate::spectrum::SampledWavelengths;
+
+/// Everything rays can hit or be lit by.
+pub struct Scene {
+    primitives: Vec<Primitive>,
+    bvh: Bvh,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    infinite_lights: Vec<LightId>,
+    light_sampler: LightSampler,
+    bounds: Bounds3,
+}
+
+impl Scene {
+    /// Assembles a scene; lights are preprocessed with the scene bounds.
+    pub fn new(
+        primitives: Vec<Primitive>,
+        materials: Vec<Material>,
+        mut lights: Vec<Light>,
+        power_sampling: bool,
+    ) -> Self {
+        let prim_bounds: Vec<Bounds3> = primitives.iter().map(|p| p.shape.bounds()).collect();
+        let bounds = prim_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
+        let bvh = Bvh::build(&prim_bounds);
+        for l in &mut lights {
+            l.preprocess(&bounds);
+        }
+        let infinite_lights = (0..lights.len())
+            .filter(|&i| matches!(lights[i].light_type(), crate::light::LightType::Infinite))
+            .map(|i| LightId(i as u32))
+            .collect();
+        let light_sampler = if power_sampling {
+            LightSampler::power(&lights)
+        } else {
+            LightSampler::uniform(&lights)
+        };
+        Self {
+            primitives,
+            bvh,
+            materials,
+            lights,
+            infinite_lights,
+            light_sampler,
+            bounds,
+        }
+    }
+
+    /// Bounds of all geometry.
+    pub fn bounds(&self) -> Bounds3 {
+        self.bounds
+    }
+    /// Number of primitives.
+    pub fn primitive_count(&self) -> usize {
+        self.primitives.len()
+    }
+    /// All lights.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+    /// One light.
+    #[inline]
+    pub fn light(&self, id: LightId) -> &Light {
+        &self.lights[id.0 as usize]
+    }
+    /// Lights at infinity (seen by escaping rays).
+    pub fn infinite_lights(&self) -> &[LightId] {
+        &self.infinite_lights
+    }
+    /// The light-selection distribution.
+    pub fn light_sampler(&self) -> &LightSampler {
+        &self.light_sampler
+    }
+    /// All materials.
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Closest hit along `ray` before `t_max`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
+        let mut best = None;
+        self.bvh.intersect(ray, t_max, |i, ray, t_max| {
+            let prim = &self.primitives[i as usize];
+            let hit = prim.shape.intersect(ray, t_max)?;
+            let t = hit.t_hit;
+            let mut si = hit.si;
+            si.material = prim.material;
+            si.area_light = prim.area_light;
+            best = Some(si);
+            Some(t)
+        });
+        best
+    }
+
+    /// True if anything blocks `ray` before `t_max`.
+    pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
+        self.bvh.intersect_p(ray, t_max, |i, ray, t_max| {
+            self.primitives[i as usize].shape.intersect_p(ray, t_max)
+        })
+    }
+
+    /// True if the segment between two interactions is free.
+    pub fn unoccluded(&self, a: &Interaction, b: &Interaction) -> bool {
+        let ray = a.spawn_ray_to(b);
+        !self.intersect_p(&ray, 1.0 - SHADOW_EPSILON)
+    }
+
+    /// The BSDF at a hit (`None` for interface materials), with the
+    /// material's textures evaluated for `lambda`.
+    pub fn bsdf(&self, si: &SurfaceInteraction, lambda: &mut SampledWavelengths) -> Option<Bsdf> {
+        let m = &self.materials[si.material?.0 as usize];
+        m.bsdf(si, lambda)
+    }
+}

@@ -1,0 +1,243 @@
+//! Colour: RGB and XYZ triples, RGB colour spaces, and the pixel sensor.
+
+use super::rgb2spec::{fit_sigmoid, RgbSigmoidPolynomial};
+use super::spectra::{spectrum_to_xyz, PiecewiseLinear, Spectrum};
+use super::{cie_xyz, named, SampledSpectrum, SampledWavelengths};
+use glam::{Mat3, Vec3};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// A linear RGB triple.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rgb {
+    /// Red.
+    pub r: f32,
+    /// Green.
+    pub g: f32,
+    /// Blue.
+    pub b: f32,
+}
+
+impl Rgb {
+    /// New triple.
+    pub fn new(r: f32, g: f32, b: f32) -> Self {
+        Self { r, g, b }
+    }
+}
+
+/// CIE XYZ tristimulus values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Xyz {
+    /// X.
+    pub x: f32,
+    /// Y (luminance).
+    pub y: f32,
+    /// Z.
+    pub z: f32,
+}
+
+impl Xyz {
+    /// Chromaticity (x, y).
+    pub fn xy(&self) -> (f32, f32) {
+        let s = self.x + self.y + self.z;
+        (self.x / s, self.y / s)
+    }
+    /// From chromaticity with luminance `y_lum`.
+    pub fn from_xy(x: f32, y: f32, y_lum: f32) -> Self {
+        if y == 0.0 {
+            return Self {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            };
+        }
+        Self {
+            x: x * y_lum / y,
+            y: y_lum,
+            z: (1.0 - x - y) * y_lum / y,
+        }
+    }
+    fn vec(self) -> Vec3 {
+        Vec3::new(self.x, self.y, self.z)
+    }
+}
+
+impl SampledSpectrum {
+    /// Monte Carlo estimate of XYZ: the average over samples of x̄(λ)·s(λ)/p(λ),
+    /// divided by ∫ȳ so the unit equal-energy spectrum has Y = 1.
+    pub fn to_xyz(&self, lambda: &SampledWavelengths) -> Xyz {
+        let v = sensor_response(*self, lambda);
+        let k = super::CIE_Y_INTEGRAL;
+        Xyz {
+            x: v[0] / k,
+            y: v[1] / k,
+            z: v[2] / k,
+        }
+    }
+}
+
+/// Average of cmf(λ)·s(λ)/p(λ) per channel (estimates ∫ cmf·s dλ).
+fn sensor_response(s: SampledSpectrum, lambda: &SampledWavelengths) -> [f32; 3] {
+    let l = s.safe_div(lambda.pdf());
+    let mut out = [0.0f32; 3];
+    for i in 0..super::N_SPECTRUM_SAMPLES {
+        let c = cie_xyz(lambda.lambda(i));
+        for k in 0..3 {
+            out[k] += c[k] * l[i];
+        }
+    }
+    out.map(|v| v / super::N_SPECTRUM_SAMPLES as f32)
+}
+
+/// An RGB colour space: primaries, white point (from its standard illuminant)
+/// and the RGB → spectrum model.
+pub struct ColorSpace {
+    /// Name as pbrt-v4 spells it.
+    pub name: &'static str,
+    /// The standard illuminant (normalised to luminance Y = 1).
+    pub illuminant: Spectrum,
+    /// The same illuminant as a table.
+    pub illuminant_table: Arc<PiecewiseLinear>,
+    /// XYZ from linear RGB.
+    pub xyz_from_rgb: Mat3,
+    /// Linear RGB from XYZ.
+    pub rgb_from_xyz: Mat3,
+    cache: Mutex<HashMap<[u32; 3], RgbSigmoidPolynomial>>,
+}
+
+impl std::fmt::Debug for ColorSpace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ColorSpace({})", self.name)
+    }
+}
+
+impl ColorSpace {
+    fn new(
+        name: &'static str,
+        r: (f32, f32),
+        g: (f32, f32),
+        b: (f32, f32),
+        illum: Arc<PiecewiseLinear>,
+    ) -> Self {
+        let illuminant = Spectrum::PiecewiseLinear(illum.clone());
+        // [pbrt-v4 RGBColorSpace]: scale the primaries so that RGB (1,1,1) is the white point.
+        let w = spectrum_to_xyz(&illuminant).vec();
+        let m = Mat3::from_cols(
+            Xyz::from_xy(r.0, r.1, 1.0).vec(),
+            Xyz::from_xy(g.0, g.1, 1.0).vec(),
+            Xyz::from_xy(b.0, b.1, 1.0).vec(),
+        );
+        let c = m.inverse() * w;
+        let xyz_from_rgb = m * Mat3::from_diagonal(c);
+        Self {
+            name,
+            illuminant,
+            illuminant_table: illum,
+            xyz_from_rgb,
+            rgb_from_xyz: xyz_from_rgb.inverse(),
+            cache: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// Linear sRGB (Rec. 709 primaries, D65).
+    pub fn srgb() -> &'static ColorSpace {
+        static CS: OnceLock<ColorSpace> = OnceLock::new();
+        CS.get_or_init(|| {
+            ColorSpace::new(
+                "srgb",
+                (0.64, 0.33),
+                (0.30, 0.60),
+                (0.15, 0.06),
+                named::d65(),
+            )
+        })
+    }
+    /// Rec. 2020 (D65).
+    pub fn rec2020() -> &'static ColorSpace {
+        static CS: OnceLock<ColorSpace> = OnceLock::new();
+        CS.get_or_init(|| {
+            ColorSpace::new(
+                "rec2020",
+                (0.708, 0.292),
+                (0.170, 0.797),
+                (0.131, 0.046),
+                named::d65(),
+            )
+        })
+    }
+    /// DCI-P3 primaries with a D65 white (pbrt-v4's "dci-p3").
+    pub fn dci_p3() -> &'static ColorSpace {
+        static CS: OnceLock<ColorSpace> = OnceLock::new();
+        CS.get_or_init(|| {
+            ColorSpace::new(
+                "dci-p3",
+                (0.680, 0.320),
+                (0.265, 0.690),
+                (0.150, 0.060),
+                named::d65(),
+            )
+        })
+    }
+    /// Looks up a colour space by pbrt-v4 name (`aces2065-1` is not available yet).
+    pub fn by_name(name: &str) -> Option<&'static ColorSpace> {
+        match name {
+            "srgb" => Some(Self::srgb()),
+            "rec2020" => Some(Self::rec2020()),
+            "dci-p3" => Some(Self::dci_p3()),
+            _ => None,
+        }
+    }
+
+    /// Linear RGB of an XYZ value.
+    pub fn to_rgb(&self, xyz: Xyz) -> Rgb {
+        let v = self.rgb_from_xyz * xyz.vec();
+        Rgb::new(v.x, v.y, v.z)
+    }
+
+    /// Sigmoid-polynomial coefficients of an RGB in [0,1]³, fitted on demand
+    /// by Gauss–Newton [Jakob & Hanika 2019] and memoised per distinct RGB.
+    pub fn to_rgb_coeffs(&self, rgb: Rgb) -> RgbSigmoidPolynomial {
+        let rgb = Rgb::new(
+            rgb.r.clamp(0.0, 1.0),
+            rgb.g.clamp(0.0, 1.0),
+            rgb.b.clamp(0.0, 1.0),
+        );
+        if rgb.r == rgb.g && rgb.g == rgb.b {
+            return RgbSigmoidPolynomial::constant(rgb.r);
+        }
+        let key = [rgb.r.to_bits(), rgb.g.to_bits(), rgb.b.to_bits()];
+        if let Some(p) = self.cache.lock().ok().and_then(|c| c.get(&key).copied()) {
+            return p;
+        }
+        let p = fit_sigmoid(self, rgb);
+        if let Ok(mut c) = self.cache.lock() {
+            c.insert(key, p);
+        }
+        p
+    }
+}
+
+/// The camera sensor of pbrt-v4's `rgb` film. Only `cie1931` so far: the
+/// sensor's response is XYZ itself, scaled by the imaging ratio
+/// (exposure time · ISO / 100).
+#[derive(Clone, Debug)]
+pub struct PixelSensor {
+    imaging_ratio: f32,
+}
+
+impl PixelSensor {
+    /// The CIE 1931 sensor.
+    pub fn cie1931(imaging_ratio: f32) -> Self {
+        Self { imaging_ratio }
+    }
+    /// Sensor RGB of sampled radiance: imaging ratio × (∫ x̄ L, ∫ ȳ L, ∫ z̄ L)
+    /// estimated from the samples. No 1/∫ȳ here: pbrt-v4 folds that into the
+    /// lights' 1/`SpectrumToPhotometric` scale, so a 1-nit white light reads 1.
+    pub fn to_sensor_rgb(&self, l: SampledSpectrum, lambda: &SampledWavelengths) -> [f32; 3] {
+        sensor_response(l, lambda).map(|v| v * self.imaging_ratio)
+    }
+    /// XYZ from sensor RGB (identity for `cie1931`).
+    pub fn xyz_from_sensor_rgb(&self) -> Mat3 {
+        Mat3::IDENTITY
+    }
+}

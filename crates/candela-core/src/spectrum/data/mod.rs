@@ -1,0 +1,4 @@
+//! Measured spectral tables (generated; see each file's header).
+
+pub mod cie;
+pub mod metals;

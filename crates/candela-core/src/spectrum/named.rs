@@ -1,0 +1,101 @@
+//! Spectra that pbrt-v4 scenes name by string: CIE standard illuminants
+//! (normalised to luminance Y = 1 as pbrt-v4 does), metal optical constants
+//! and glass dispersion (Sellmeier equations with Schott's coefficients).
+
+use super::data::{cie, metals};
+use super::spectra::{inner_product, PiecewiseLinear, Spectrum};
+use super::{cie_xyz, CIE_Y_INTEGRAL};
+use std::sync::{Arc, OnceLock};
+
+/// Scales a table so that ∫ȳ s = ∫ȳ (pbrt-v4 `FromInterleaved(normalize = true)`).
+fn normalized(p: PiecewiseLinear) -> PiecewiseLinear {
+    let y = inner_product(|l| cie_xyz(l)[1], |l| p.eval(l));
+    p.scaled(CIE_Y_INTEGRAL / y)
+}
+
+/// CIE D65, normalised.
+pub fn d65() -> Arc<PiecewiseLinear> {
+    static S: OnceLock<Arc<PiecewiseLinear>> = OnceLock::new();
+    S.get_or_init(|| {
+        Arc::new(normalized(PiecewiseLinear::from_even(
+            cie::D65_START,
+            5.0,
+            &cie::ILLUM_D65,
+        )))
+    })
+    .clone()
+}
+
+fn d50() -> Arc<PiecewiseLinear> {
+    static S: OnceLock<Arc<PiecewiseLinear>> = OnceLock::new();
+    S.get_or_init(|| {
+        Arc::new(normalized(PiecewiseLinear::from_even(
+            cie::D50_START,
+            5.0,
+            &cie::ILLUM_D50,
+        )))
+    })
+    .clone()
+}
+
+/// CIE illuminant A by its defining formula (CIE 15: Planck with c₂ = 1.435·10⁷ nm·K, T = 2848 K).
+fn illuminant_a() -> Arc<PiecewiseLinear> {
+    static S: OnceLock<Arc<PiecewiseLinear>> = OnceLock::new();
+    S.get_or_init(|| {
+        let f = |l: f64| {
+            100.0 * (560.0 / l).powi(5) * ((1.435e7f64 / (2848.0 * 560.0)).exp() - 1.0)
+                / ((1.435e7f64 / (2848.0 * l)).exp() - 1.0)
+        };
+        let pairs: Vec<(f32, f32)> = (300..=830)
+            .map(|l| (l as f32, f(l as f64) as f32))
+            .collect();
+        Arc::new(normalized(PiecewiseLinear::new(&pairs)))
+    })
+    .clone()
+}
+
+/// Sellmeier dispersion n(λ) with λ in μm.
+fn sellmeier(b: [f64; 3], c: [f64; 3]) -> Spectrum {
+    let pairs: Vec<(f32, f32)> = (300..=900)
+        .step_by(2)
+        .map(|l| {
+            let x = (l as f64 / 1000.0).powi(2);
+            let n2 = 1.0 + (0..3).map(|i| b[i] * x / (x - c[i])).sum::<f64>();
+            (l as f32, n2.sqrt() as f32)
+        })
+        .collect();
+    Spectrum::piecewise_linear(&pairs)
+}
+
+fn table(l: &[f32], v: &[f32]) -> Spectrum {
+    let pairs: Vec<(f32, f32)> = l.iter().zip(v).map(|(a, b)| (*a, *b)).collect();
+    Spectrum::piecewise_linear(&pairs)
+}
+
+/// The spectrum pbrt-v4 registers under `name`, or `None` if candela does not have it.
+pub fn named_spectrum(name: &str) -> Option<Spectrum> {
+    Some(match name {
+        "stdillum-D65" => Spectrum::PiecewiseLinear(d65()),
+        "stdillum-D50" => Spectrum::PiecewiseLinear(d50()),
+        "stdillum-A" => Spectrum::PiecewiseLinear(illuminant_a()),
+        "metal-Cu-eta" => table(&metals::CU_LAMBDA, &metals::CU_ETA),
+        "metal-Cu-k" => table(&metals::CU_LAMBDA, &metals::CU_K),
+        "glass-BK7" => sellmeier(
+            [1.039_612_12, 0.231_792_344, 1.010_469_45],
+            [0.006_000_698_67, 0.020_017_914_4, 103.560_653],
+        ),
+        "glass-BAF10" => sellmeier(
+            [1.585_149_5, 0.143_559_385, 1.085_212_69],
+            [0.009_266_812_82, 0.042_448_980_5, 105.613_573],
+        ),
+        "glass-FK51A" => sellmeier(
+            [0.971_247_817, 0.216_901_417, 0.904_651_666],
+            [0.004_723_019_95, 0.015_357_561_2, 168.681_33],
+        ),
+        "glass-LASF9" => sellmeier(
+            [2.000_295_47, 0.298_926_886, 1.806_918_43],
+            [0.012_142_601_7, 0.053_873_623_6, 156.530_829],
+        ),
+        _ => return None,
+    })
+}

@@ -1,0 +1,169 @@
+//! Spectral tests: T8 photometry (validation.md), colour-space round trips,
+//! the white-emitter invariant that makes pbrt-v4 scenes render to
+//! pbrt-v4's numbers, and named spectra.
+
+use super::*;
+use crate::sampling::Pcg32;
+
+/// ∫ ȳ(λ) f(λ) dλ over 360–830 nm at 1 nm steps.
+fn y_of(f: impl Fn(f32) -> f32) -> f64 {
+    (360..=830)
+        .map(|l| cie_xyz(l as f32)[1] as f64 * f(l as f32) as f64)
+        .sum()
+}
+
+#[test]
+fn t8_luminous_efficacy_of_monochromatic_and_flat_spectra() {
+    // 1 W at 555 nm → 683 lm; 1 W at 650 nm → 73.08 lm (0.1 %).
+    assert!((K_M * cie_xyz(555.0)[1] - 683.0).abs() < 0.683);
+    assert!((K_M * cie_xyz(650.0)[1] - 73.08).abs() < 0.0731);
+    // Equal-energy spectrum on 380–780 nm, 1 W in total: 182.457 lm/W.
+    let lm: f64 = (380..=780)
+        .map(|l| K_M as f64 * cie_xyz(l as f32)[1] as f64 / 400.0)
+        .sum();
+    assert!((lm - 182.457).abs() < 0.182, "{lm}");
+}
+
+#[test]
+fn t8_chromaticities_of_standard_illuminants() {
+    let check = |s: &Spectrum, x: f32, y: f32| {
+        let (cx, cy) = spectrum_to_xyz(s).xy();
+        assert!(
+            (cx - x).abs() < 1e-4 && (cy - y).abs() < 1e-4,
+            "({cx}, {cy}) vs ({x}, {y})"
+        );
+    };
+    check(&Spectrum::Constant(1.0), 1.0 / 3.0, 1.0 / 3.0);
+    check(&named_spectrum("stdillum-D65").unwrap(), 0.31272, 0.32903);
+    check(&named_spectrum("stdillum-A").unwrap(), 0.44757, 0.40745);
+}
+
+#[test]
+fn t8_isotropic_source_gives_spectrum_independent_photometry() {
+    // A 1000 lm isotropic source: I_v = 1000/(4π) = 79.577 cd, E_v = I_v/d² = 19.894 lx at 2 m,
+    // whatever its spectrum, once the spectrum is normalised photometrically as lights do.
+    for name in ["stdillum-D65", "stdillum-A"] {
+        let s = named_spectrum(name).unwrap();
+        for spec in [s, Spectrum::Constant(3.0)] {
+            let scale = 1000.0 / (4.0 * std::f32::consts::PI) / spectrum_to_photometric(&spec);
+            let iv = y_of(|l| spec.eval(l) * scale);
+            assert!((iv - 79.577).abs() < 1e-3, "{iv}");
+            assert!((iv / 4.0 - 19.894).abs() < 1e-3);
+        }
+    }
+}
+
+#[test]
+fn white_rgb_emitter_renders_one_through_the_sensor() {
+    // pbrt-v4: a light with "rgb L [1 1 1]" and scale 1/SpectrumToPhotometric must read sRGB (1,1,1).
+    let cs = ColorSpace::srgb();
+    let l = Spectrum::rgb_illuminant(cs, Rgb::new(1.0, 1.0, 1.0));
+    let scale = 1.0 / spectrum_to_photometric(&l);
+    let sensor = PixelSensor::cie1931(1.0);
+    // Deterministic 1 nm sweep: each λ with pdf 1 contributes its integrand.
+    let mut acc = [0.0f64; 3];
+    for l0 in 360..=830 {
+        let w = SampledWavelengths::from_parts([l0 as f32; 4], [1.0; 4]);
+        let rgb = sensor.to_sensor_rgb(l.sample(&w) * scale, &w);
+        for k in 0..3 {
+            acc[k] += rgb[k] as f64;
+        }
+    }
+    let out = cs.rgb_from_xyz
+        * sensor.xyz_from_sensor_rgb()
+        * glam::Vec3::new(acc[0] as f32, acc[1] as f32, acc[2] as f32);
+    for c in out.to_array() {
+        assert!((c - 1.0).abs() < 1e-3, "{out:?}");
+    }
+}
+
+fn albedo_rgb(cs: &ColorSpace, s: &Spectrum) -> [f32; 3] {
+    let ill = |l: f32| cs.illuminant.eval(l);
+    let norm = y_of(ill);
+    let xyz: [f64; 3] = std::array::from_fn(|k| {
+        (360..=830)
+            .map(|l| cie_xyz(l as f32)[k] as f64 * (s.eval(l as f32) * ill(l as f32)) as f64)
+            .sum::<f64>()
+            / norm
+    });
+    let v = cs.rgb_from_xyz * glam::Vec3::new(xyz[0] as f32, xyz[1] as f32, xyz[2] as f32);
+    v.to_array()
+}
+
+#[test]
+fn rgb_albedo_round_trips_through_the_spectrum() {
+    let cs = ColorSpace::srgb();
+    let colours = [
+        [0.5, 0.5, 0.5],
+        [0.885809, 0.698859, 0.666422],
+        [0.570068, 0.0430135, 0.0443706],
+        [0.105421, 0.37798, 0.076425],
+        [0.1, 0.2, 0.9],
+        [0.9, 0.9, 0.1],
+        [0.02, 0.6, 0.6],
+    ];
+    for c in colours {
+        let s = Spectrum::rgb_albedo(cs, Rgb::new(c[0], c[1], c[2]));
+        assert!(s.max_value() <= 1.0 + 1e-6);
+        let back = albedo_rgb(cs, &s);
+        for k in 0..3 {
+            assert!((back[k] - c[k]).abs() < 1e-3, "{c:?} -> {back:?}");
+        }
+    }
+    // Grey is exactly constant.
+    let g = Spectrum::rgb_albedo(cs, Rgb::new(0.5, 0.5, 0.5));
+    assert!((g.eval(400.0) - 0.5).abs() < 1e-6 && (g.eval(700.0) - 0.5).abs() < 1e-6);
+}
+
+#[test]
+fn monte_carlo_xyz_matches_exact_integral_within_5_sigma() {
+    let d65 = named_spectrum("stdillum-D65").unwrap();
+    let exact = spectrum_to_xyz(&d65);
+    let mut r = Pcg32::new(5, 0);
+    let n = 200_000;
+    let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
+    for _ in 0..n {
+        let w = SampledWavelengths::sample_visible(r.uniform_f32());
+        let x = d65.sample(&w).to_xyz(&w);
+        for (k, v) in [x.x, x.y, x.z].into_iter().enumerate() {
+            s[k] += v as f64;
+            s2[k] += (v as f64).powi(2);
+        }
+    }
+    for (k, e) in [exact.x, exact.y, exact.z].into_iter().enumerate() {
+        let m = s[k] / n as f64;
+        let sigma = ((s2[k] / n as f64 - m * m) / n as f64).sqrt();
+        // b = 2e-3 relative: the 1 nm rectangle rule of the exact value vs the continuous MC integral.
+        assert!(
+            (m - e as f64).abs() < 5.0 * sigma + 2e-3 * e as f64,
+            "channel {k}: {m} vs {e} (σ {sigma})"
+        );
+    }
+}
+
+#[test]
+fn named_glasses_and_metals() {
+    for (name, nd) in [
+        ("glass-BK7", 1.5168),
+        ("glass-BAF10", 1.6700),
+        ("glass-FK51A", 1.4866),
+        ("glass-LASF9", 1.8503),
+    ] {
+        let n = named_spectrum(name).unwrap().eval(587.6);
+        assert!((n - nd).abs() < 1e-3, "{name}: {n} vs {nd}");
+    }
+    let (eta, k) = (
+        named_spectrum("metal-Cu-eta").unwrap(),
+        named_spectrum("metal-Cu-k").unwrap(),
+    );
+    assert!(eta.eval(600.0) > 0.0 && k.eval(600.0) > 2.0);
+    assert!(named_spectrum("no-such-spectrum").is_none());
+}
+
+#[test]
+fn blackbody_is_normalised_to_its_peak() {
+    let b = Spectrum::blackbody(6500.0);
+    let peak = 2.897_772e-3 / 6500.0 * 1e9;
+    assert!((b.eval(peak) - 1.0).abs() < 1e-4);
+    assert!(b.eval(peak - 30.0) < 1.0 && b.eval(peak + 30.0) < 1.0);
+}

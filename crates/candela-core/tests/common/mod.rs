@@ -1,0 +1,65 @@
+//! Shared helpers for the integration tests: render a scene given as text
+//! and measure image statistics.
+
+use candela_core::image::RgbImage;
+use candela_core::integrator::{NoProgress, RenderContext};
+use candela_core::scene::build::{build, Overrides};
+use std::path::Path;
+
+/// Renders pbrt-v4 scene text with the given overrides; asserts no sample was dropped.
+pub fn render_str(text: &str, ov: &Overrides) -> RgbImage {
+    let desc = candela_scene::parse_str(text, Path::new("test.pbrt")).expect("scene parses");
+    let mut setup = build(&desc, ov).expect("scene builds");
+    let ctx = RenderContext {
+        scene: &setup.scene,
+        camera: &setup.camera,
+        sampler: &setup.sampler,
+        progress: &NoProgress,
+    };
+    setup.integrator.render(&ctx, &mut setup.film);
+    assert_eq!(
+        setup.film.dropped_samples(),
+        0,
+        "non-finite samples were produced"
+    );
+    setup.film.image(1.0)
+}
+
+/// Mean and standard error of the mean of channel `c` over pixels in `[x0,x1)×[y0,y1)`.
+/// Pixels are independent estimates (each reseeds its sampler), so the
+/// standard error is the pixel standard deviation / √n.
+pub fn region_mean(
+    img: &RgbImage,
+    c: usize,
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    y1: usize,
+) -> (f64, f64) {
+    let vals: Vec<f64> = (y0..y1)
+        .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+        .map(|(x, y)| img.get(x, y)[c] as f64)
+        .collect();
+    let n = vals.len() as f64;
+    let mean = vals.iter().sum::<f64>() / n;
+    let var = vals.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Asserts `|mean − expected| ≤ 5σ + b` for every channel of the region (validation.md's rule).
+pub fn assert_region(
+    img: &RgbImage,
+    region: (usize, usize, usize, usize),
+    expected: f64,
+    b: f64,
+    what: &str,
+) {
+    for c in 0..3 {
+        let (m, se) = region_mean(img, c, region.0, region.1, region.2, region.3);
+        eprintln!("{what}: channel {c}: mean {m:.6} ± {se:.6} (expected {expected})");
+        assert!(
+            (m - expected).abs() <= 5.0 * se + b,
+            "{what}: channel {c} mean {m} vs {expected} (σ {se}, b {b})"
+        );
+    }
+}
