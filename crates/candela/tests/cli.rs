@@ -31,15 +31,27 @@ fn render_writes_exr_and_png_and_warns_about_unused_parameters() {
     let scene = d.join("s.pbrt");
     std::fs::write(&scene, SMALL).unwrap();
     let out = d.join("img.exr");
-    let o = candela().args(["render"]).arg(&scene).args(["--spp", "2", "--quiet", "--outfile"]).arg(&out).output().unwrap();
+    let o = candela()
+        .args(["render"])
+        .arg(&scene)
+        .args(["--spp", "2", "--quiet", "--outfile"])
+        .arg(&out)
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(out.exists() && d.join("img.png").exists());
-    assert!(err.contains("unused parameter \"bogus\"") && err.contains("s.pbrt:2:"), "{err}");
+    assert!(
+        err.contains("unused parameter \"bogus\"") && err.contains("s.pbrt:2:"),
+        "{err}"
+    );
     // diff of an image against itself: ratio 1, zero error.
     let o = candela().arg("diff").arg(&out).arg(&out).output().unwrap();
     let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success() && text.contains("relMSE (eps 0.01)  0.000000"), "{text}");
+    assert!(
+        o.status.success() && text.contains("relMSE (eps 0.01)  0.000000"),
+        "{text}"
+    );
     std::fs::remove_dir_all(&d).ok();
 }
 
@@ -47,21 +59,47 @@ fn render_writes_exr_and_png_and_warns_about_unused_parameters() {
 fn errors_name_file_line_column_and_exit_non_zero() {
     let d = tmpdir("errors");
     let cases = [
-        (SMALL.replace("Shape \"sphere\"", "Shape \"hyperboloid\""), ":9:1", "hyperboloid"),
-        (SMALL.replace("\"float fov\" [45]", "\"float fov\" [\"wide\"]"), ":2:", "fov"),
+        (
+            SMALL.replace("Shape \"sphere\"", "Shape \"hyperboloid\""),
+            ":9:1",
+            "hyperboloid",
+        ),
+        (
+            SMALL.replace("\"float fov\" [45]", "\"float fov\" [\"wide\"]"),
+            ":2:",
+            "fov",
+        ),
         (format!("{SMALL}Frobnicate 1 2 3\n"), ":10:1", "Frobnicate"),
-        (SMALL.replace("Integrator \"path\"", "Integrator \"mlt\""), ":5:1", "mlt"),
+        (
+            SMALL.replace("Integrator \"path\"", "Integrator \"mlt\""),
+            ":5:1",
+            "mlt",
+        ),
     ];
     for (i, (text, loc, word)) in cases.iter().enumerate() {
         let scene = d.join(format!("bad{i}.pbrt"));
         std::fs::write(&scene, text).unwrap();
-        let o = candela().arg("render").arg(&scene).args(["--quiet", "--outfile"]).arg(d.join("x.exr")).output().unwrap();
+        let o = candela()
+            .arg("render")
+            .arg(&scene)
+            .args(["--quiet", "--outfile"])
+            .arg(d.join("x.exr"))
+            .output()
+            .unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "case {i} should fail");
-        assert!(err.contains(&format!("bad{i}.pbrt{loc}")) && err.contains(word), "case {i}: {err}");
+        assert!(
+            err.contains(&format!("bad{i}.pbrt{loc}")) && err.contains(word),
+            "case {i}: {err}"
+        );
         assert!(!err.contains("panicked"), "case {i}: {err}");
     }
-    let o = candela().args(["render", "/no/such/file.pbrt"]).output().unwrap();
-    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("/no/such/file.pbrt"));
+    let o = candela()
+        .args(["render", "/no/such/file.pbrt"])
+        .output()
+        .unwrap();
+    assert!(
+        !o.status.success() && String::from_utf8_lossy(&o.stderr).contains("/no/such/file.pbrt")
+    );
     std::fs::remove_dir_all(&d).ok();
 }

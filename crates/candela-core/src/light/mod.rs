@@ -39,12 +39,10 @@ mod emission;
 mod infinite;
 mod point;
 mod sampler;
-#[cfg(test)]
-pub mod shape_stub;
 mod spot;
 
 #[cfg(test)]
-mod tests {}
+mod tests;
 
 pub use create::{
     diffuse_area_light, distant_light, point_light, spot_light, uniform_infinite_light,

@@ -226,8 +226,23 @@ fn pooled_chi2(obs: &[f64], exp: &[f64]) -> (f64, usize) {
     (stat, cells.saturating_sub(1).max(1))
 }
 
-fn area(shape: Shape, two_sided: bool) -> Light {
-    Light::DiffuseArea(DiffuseAreaLight::new(shape, constant(1.0), 1.0, two_sided))
+fn area(geo: Geo, two_sided: bool) -> Light {
+    Light::DiffuseArea(DiffuseAreaLight::new(
+        geo.shape(),
+        constant(1.0),
+        1.0,
+        two_sided,
+    ))
+}
+
+/// One of the two triangles of a parallelogram light.
+fn half(geo: Geo, which: usize, two_sided: bool) -> Light {
+    Light::DiffuseArea(DiffuseAreaLight::new(
+        geo.shapes().remove(which),
+        constant(1.0),
+        1.0,
+        two_sided,
+    ))
 }
 
 /// χ² of `sample_li` directions from `p` against `pdf_li`.
@@ -249,7 +264,7 @@ fn chi2_li(name: &str, light: &Light, p: Vec3, n: Vec3, axis: Vec3, cos_lo: f32)
 fn chi2_sphere_light_li() {
     // Sphere of radius 1 at distance 2: cone cos θ_max = 0.866; grid on [0.8, 1].
     let light = area(
-        Shape::Sphere {
+        Geo::Sphere {
             center: Vec3::new(0.0, 0.0, 2.0),
             radius: 1.0,
         },
@@ -262,7 +277,8 @@ fn chi2_sphere_light_li() {
 fn chi2_quad_light_li() {
     // 2×2 square at distance 1, receiver off-centre; and a grazing view
     // (incidence on the light 75°–84° from its normal).
-    let light = area(square(Vec3::Z, 2.0, true), false);
+    // One triangle (half) of the square: a mesh quad is two triangle lights.
+    let light = half(square(Vec3::Z, 2.0, true), 0, false);
     chi2_li(
         "quad li",
         &light,
@@ -279,8 +295,8 @@ fn chi2_quad_light_li() {
 fn chi2_area_light_le() {
     // Directions of sample_le against pdf_le_area's direction density; the
     // square is planar, so every point shares the normal −z.
-    for (name, two) in [("quad le", false), ("quad le two-sided", true)] {
-        let light = area(square(Vec3::Z, 2.0, true), two);
+    for (name, two, which) in [("quad le", false, 0), ("quad le two-sided", true, 1)] {
+        let light = half(square(Vec3::Z, 2.0, true), which, two);
         let it = Interaction {
             p: Vec3::Z,
             p_error: Vec3::ZERO,

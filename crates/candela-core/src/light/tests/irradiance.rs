@@ -35,33 +35,47 @@ fn t1_point_light_over_plane() {
 
 /// Monte Carlo E = ∫ L cos dω through `sample_li`, with pdf_li checked per sample.
 fn irradiance(light: &Light, ctx: &LightSampleContext, seed: u64, n: usize) -> Stats {
+    irradiance_sum(std::slice::from_ref(light), ctx, seed, n)
+}
+
+/// E = Σ over lights of one `sample_li` estimate ∫ L cos dω each, per trial
+/// (a mesh quad is two triangle lights whose irradiances add).
+fn irradiance_sum(lights: &[Light], ctx: &LightSampleContext, seed: u64, n: usize) -> Stats {
     let lam = lambda();
     let mut r = Pcg32::new(seed, 9);
     let mut st = Stats::default();
     for _ in 0..n {
-        let Some(s) = light.sample_li(ctx, u2(&mut r), &lam) else {
-            st.add(0.0);
-            continue;
-        };
-        let p = light.pdf_li(ctx, s.wi);
-        assert!(
-            (p.0 - s.pdf.0).abs() <= 1e-3 * s.pdf.0,
-            "pdf_li {} vs {}",
-            p.0,
-            s.pdf.0
-        );
-        st.add((s.l[0] * s.wi.dot(ctx.n).max(0.0) / s.pdf.0) as f64);
+        let mut e = 0.0f64;
+        for light in lights {
+            let Some(s) = light.sample_li(ctx, u2(&mut r), &lam) else {
+                continue;
+            };
+            let p = light.pdf_li(ctx, s.wi);
+            assert!(
+                (p.0 - s.pdf.0).abs() <= 1e-3 * s.pdf.0,
+                "pdf_li {} vs {}",
+                p.0,
+                s.pdf.0
+            );
+            e += (s.l[0] * s.wi.dot(ctx.n).max(0.0) / s.pdf.0) as f64;
+        }
+        st.add(e);
     }
     st
 }
 
 fn disk_light(center: Vec3, radius: f32) -> Light {
-    let shape = Shape::Disk {
+    let shape = Geo::Disk {
         center,
         n: -Vec3::Z,
         radius,
     };
-    Light::DiffuseArea(DiffuseAreaLight::new(shape, constant(1.0), 1.0, false))
+    Light::DiffuseArea(DiffuseAreaLight::new(
+        shape.shape(),
+        constant(1.0),
+        1.0,
+        false,
+    ))
 }
 
 #[test]
@@ -80,16 +94,15 @@ fn t2_disk_irradiance() {
 #[test]
 fn t2_square_irradiance() {
     // Centred 2×2 square at distance 1: 1.7408395 L; receiver tilted 45°: 1.2309594 L.
-    let light = Light::DiffuseArea(DiffuseAreaLight::new(
-        square(Vec3::Z, 2.0, true),
-        constant(1.0),
-        1.0,
-        false,
-    ));
-    let st = irradiance(&light, &receiver(Vec3::ZERO, Vec3::Z), 3, 100_000);
+    let lights: Vec<Light> = square(Vec3::Z, 2.0, true)
+        .shapes()
+        .into_iter()
+        .map(|s| Light::DiffuseArea(DiffuseAreaLight::new(s, constant(1.0), 1.0, false)))
+        .collect();
+    let st = irradiance_sum(&lights, &receiver(Vec3::ZERO, Vec3::Z), 3, 100_000);
     st.assert_mean(1.7408395, 1e-6, "square");
     let tilted = Vec3::new(1.0, 0.0, 1.0).normalize();
-    let st = irradiance(&light, &receiver(Vec3::ZERO, tilted), 4, 100_000);
+    let st = irradiance_sum(&lights, &receiver(Vec3::ZERO, tilted), 4, 100_000);
     st.assert_mean(1.2309594, 1e-6, "tilted square");
 }
 
@@ -103,12 +116,17 @@ fn one_sided_light_is_dark_behind() {
         .sample_li(&ctx, Vec2::new(0.3, 0.6), &lambda())
         .is_none());
     let l = |two: bool, w: Vec3| {
-        let shape = Shape::Disk {
+        let shape = Geo::Disk {
             center: Vec3::ZERO,
             n: Vec3::Z,
             radius: 1.0,
         };
-        let a = Light::DiffuseArea(DiffuseAreaLight::new(shape, constant(2.0), 1.0, two));
+        let a = Light::DiffuseArea(DiffuseAreaLight::new(
+            shape.shape(),
+            constant(2.0),
+            1.0,
+            two,
+        ));
         a.l(Vec3::ZERO, Vec3::Z, Vec2::ZERO, w, &lambda())[0]
     };
     assert_eq!((l(false, Vec3::Z), l(false, -Vec3::Z)), (2.0, 0.0));

@@ -6,13 +6,14 @@
 //! stated round-off allowance.
 
 mod chi2;
+mod fixtures;
 mod irradiance;
 mod power;
 
-use super::shape_stub::Shape;
 use super::*;
 use crate::math::Vec2;
 use crate::sampling::Pcg32;
+pub(super) use fixtures::Geo;
 
 /// Constant emission spectrum (the one place tests build spectra).
 pub(super) fn constant(v: f32) -> LightSpectrum {
@@ -67,13 +68,13 @@ impl Stats {
 }
 
 /// Axis-aligned square of side `s` centred at `c`, normal ±z (`down` = −z).
-pub(super) fn square(c: Vec3, s: f32, down: bool) -> Shape {
+pub(super) fn square(c: Vec3, s: f32, down: bool) -> Geo {
     let (e1, e2) = if down {
         (Vec3::new(0.0, s, 0.0), Vec3::new(s, 0.0, 0.0))
     } else {
         (Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, s, 0.0))
     };
-    Shape::Quad {
+    Geo::Quad {
         p0: c - 0.5 * (e1 + e2),
         e1,
         e2,

@@ -12,18 +12,31 @@ fn spot() -> Light {
     Light::Spot(SpotLight::new(t, constant(50.0), 1.0, 30.0, 25.0))
 }
 
-fn area(shape: Shape, l: f32, two_sided: bool) -> Light {
-    Light::DiffuseArea(DiffuseAreaLight::new(shape, constant(l), 1.0, two_sided))
+fn area(geo: Geo, l: f32, two_sided: bool) -> Light {
+    Light::DiffuseArea(DiffuseAreaLight::new(
+        geo.shape(),
+        constant(l),
+        1.0,
+        two_sided,
+    ))
+}
+
+/// The lights of a parallelogram (two triangles), as a mesh quad in a scene.
+fn areas(geo: Geo, l: f32, two_sided: bool) -> Vec<Light> {
+    geo.shapes()
+        .into_iter()
+        .map(|s| Light::DiffuseArea(DiffuseAreaLight::new(s, constant(l), 1.0, two_sided)))
+        .collect()
 }
 
 /// One light of every type and shape, with its closed-form Φ.
 fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
     let a = 0.25f64; // 0.5 × 0.5 square
-    let sphere = Shape::Sphere {
+    let sphere = Geo::Sphere {
         center: Vec3::new(0.0, 1.0, 0.0),
         radius: 0.5,
     };
-    let tri = Shape::Triangle {
+    let tri = Geo::Triangle {
         p: [
             Vec3::ZERO,
             Vec3::new(1.0, 0.0, 0.0),
@@ -34,7 +47,7 @@ fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
         * Vec3::new(1.0, 0.0, 0.0)
             .cross(Vec3::new(0.0, 2.0, 0.5))
             .length() as f64;
-    let disk = Shape::Disk {
+    let disk = Geo::Disk {
         center: Vec3::ZERO,
         n: Vec3::new(0.0, 0.6, 0.8),
         radius: 0.7,
@@ -56,14 +69,14 @@ fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
         ("distant", distant, 2.0 * pi * r2),
         ("infinite", inf, 0.5 * 4.0 * pi * pi * r2),
         (
-            "quad",
-            area(square(Vec3::Z, 0.5, true), 10.0, false),
-            pi * a * 10.0,
+            "half quad",
+            areas(square(Vec3::Z, 0.5, true), 10.0, false).remove(0),
+            pi * a / 2.0 * 10.0,
         ),
         (
-            "quad 2-sided",
-            area(square(Vec3::Z, 0.5, true), 10.0, true),
-            2.0 * pi * a * 10.0,
+            "half quad 2-sided",
+            areas(square(Vec3::Z, 0.5, true), 10.0, true).remove(1),
+            2.0 * pi * a / 2.0 * 10.0,
         ),
         ("sphere", area(sphere.clone(), 3.0, false), pi * pi * 3.0),
         (
@@ -92,8 +105,13 @@ fn point_phi_is_4pi_i() {
 #[test]
 fn area_phi_is_pi_a_l() {
     // A = 0.25, L = 10 → πAL = 7.853982; two-sided 2πAL = 15.707964.
-    let one = area(square(Vec3::Z, 0.5, true), 10.0, false).phi(&lambda());
-    let two = area(square(Vec3::Z, 0.5, true), 10.0, true).phi(&lambda());
+    // The square is two triangle lights; their powers add.
+    let sum = |two: bool| {
+        areas(square(Vec3::Z, 0.5, true), 10.0, two)
+            .iter()
+            .fold(SampledSpectrum::zero(), |acc, l| acc + l.phi(&lambda()))
+    };
+    let (one, two) = (sum(false), sum(true));
     assert!((one[0] - 7.853982).abs() < 2e-6, "{one:?}");
     assert!((two[0] - 15.707964).abs() < 4e-6, "{two:?}");
 }
@@ -245,8 +263,11 @@ fn create_applies_pbrt_v4_scaling() {
     let sp = spot_light(&id, s(), 1.0, 40.0, 10.0, Some(500.0), Vec3::ZERO, Vec3::X);
     check("spot power", sp.phi(&lam)[0] as f64, 500.0 / y);
     for two in [false, true] {
-        let a = diffuse_area_light(square(Vec3::Z, 0.5, true), s(), 1.0, two, Some(300.0));
-        check("area power", a.phi(&lam)[0] as f64, 300.0 / y);
+        // pbrt-v4 normalises "power" per shape: each triangle of the square emits it.
+        for shape in square(Vec3::Z, 0.5, true).shapes() {
+            let a = diffuse_area_light(shape, s(), 1.0, two, Some(300.0));
+            check("area power", a.phi(&lam)[0] as f64, 300.0 / y);
+        }
     }
     // Distant: E_v on a surface facing the light; sky: E = πL on an upward patch.
     let ctx = LightSampleContext::at_point(Vec3::ZERO);

@@ -191,12 +191,14 @@ pub fn camera(desc: &SceneDescription, film: &RgbFilm) -> Result<Camera, BuildEr
             Camera::perspective(&params)
         }
         "orthographic" => Camera::orthographic(&params),
-        other => return Err(BuildError::at(
-            &c.loc,
-            format!(
+        other => {
+            return Err(BuildError::at(
+                &c.loc,
+                format!(
                 "camera \"{other}\" is not supported yet (supported: perspective, orthographic)"
             ),
-        )),
+            ))
+        }
     };
     cam.map_err(|e| BuildError::at(&c.loc, e.to_string()))
 }

@@ -99,7 +99,9 @@ fn material(m: &MaterialDesc) -> Result<Material, BuildError> {
             "bump mapping (\"displacement\") is not supported yet",
         ));
     }
-    if m.params.get_texture("normalmap").is_some() || m.params.get_string("normalmap", "")? != "" {
+    if m.params.get_texture("normalmap").is_some()
+        || !m.params.get_string("normalmap", "")?.is_empty()
+    {
         return Err(BuildError::at(&m.loc, "\"normalmap\" is not supported yet"));
     }
     Ok(match m.ty.as_str() {
@@ -304,7 +306,7 @@ fn mesh_shapes(
     uv: Option<Vec<[f32; 2]>>,
     face: Option<Vec<i32>>,
 ) -> Result<Vec<Shape>, BuildError> {
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(BuildError::at(
             &s.loc,
             format!(
