@@ -12,6 +12,7 @@ use crate::interaction::{Interaction, LightId, SurfaceInteraction};
 use crate::light::{Light, LightSampler};
 use crate::material::Material;
 use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
+use crate::shape::WatertightRay;
 use crate::spectrum::SampledWavelengths;
 
 /// Everything rays can hit or be lit by.
@@ -92,17 +93,21 @@ impl Scene {
     /// Closest hit along `ray` before `t_max`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let mut best = None;
+        let wr = WatertightRay::new(ray);
         self.bvh.intersect(ray, t_max, |i, ray, t_max| {
-            let prim = &self.primitives[i as usize];
-            let hit = prim.shape.intersect(ray, t_max)?;
-            let t = hit.t_hit;
-            let mut si = hit.si;
-            si.material = prim.material;
-            si.area_light = prim.area_light;
-            best = Some(si);
+            let hit = self.primitives[i as usize]
+                .shape
+                .intersect_deferred(ray, &wr, t_max)?;
+            let t = hit.t();
+            best = Some((i, hit));
             Some(t)
         });
-        best
+        let (i, hit) = best?;
+        let prim = &self.primitives[i as usize];
+        let mut si = prim.shape.finish_hit(hit, ray).si;
+        si.material = prim.material;
+        si.area_light = prim.area_light;
+        Some(si)
     }
 
     /// True if anything blocks `ray` before `t_max`.

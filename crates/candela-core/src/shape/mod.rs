@@ -33,7 +33,26 @@ mod tests;
 pub use disk::Disk;
 pub use mesh::{MeshError, TriangleMesh};
 pub use sphere::Sphere;
-pub use triangle::{intersect_triangle, Triangle, TriangleIntersection};
+pub use triangle::{intersect_triangle, Triangle, TriangleIntersection, WatertightRay};
+
+/// A closest-hit candidate from [`Shape::intersect_deferred`].
+#[derive(Clone, Copy, Debug)]
+pub enum DeferredHit {
+    /// A triangle hit: barycentrics and t only.
+    Triangle(TriangleIntersection),
+    /// Another shape's complete intersection.
+    Done(ShapeIntersection),
+}
+
+impl DeferredHit {
+    /// Ray parameter of the hit.
+    pub fn t(&self) -> f32 {
+        match self {
+            DeferredHit::Triangle(t) => t.t,
+            DeferredHit::Done(h) => h.t_hit,
+        }
+    }
+}
 
 use crate::interaction::{Interaction, SurfaceInteraction};
 use crate::math::{offset_ray_origin, Bounds3, Ray, Vec2, Vec3};
@@ -139,6 +158,43 @@ impl Shape {
     /// Closest hit with `t ∈ (0, t_max)`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeIntersection> {
         dispatch!(self, s => s.intersect(ray, t_max))
+    }
+
+    /// Closest-hit test that defers building the surface interaction
+    /// (the expensive part) until the BVH traversal knows the hit is final.
+    pub fn intersect_deferred(
+        &self,
+        ray: &Ray,
+        wr: &WatertightRay,
+        t_max: f32,
+    ) -> Option<DeferredHit> {
+        match self {
+            Shape::Triangle(t) => t.intersect_raw(wr, t_max).map(DeferredHit::Triangle),
+            other => other.intersect(ray, t_max).map(DeferredHit::Done),
+        }
+    }
+
+    /// Builds the intersection of a deferred hit of this shape.
+    pub fn finish_hit(&self, hit: DeferredHit, ray: &Ray) -> ShapeIntersection {
+        match (self, hit) {
+            (Shape::Triangle(t), DeferredHit::Triangle(ti)) => ShapeIntersection {
+                si: t.interaction(&ti, -ray.d),
+                t_hit: ti.t,
+            },
+            (_, DeferredHit::Done(h)) => h,
+            (_, DeferredHit::Triangle(_)) => {
+                unreachable!("triangle hit recorded for a non-triangle shape")
+            }
+        }
+    }
+
+    /// Any-hit test with the ray's watertight constants precomputed.
+    #[inline]
+    pub fn intersect_p_with(&self, ray: &Ray, wr: &WatertightRay, t_max: f32) -> bool {
+        match self {
+            Shape::Triangle(t) => t.intersect_raw(wr, t_max).is_some(),
+            other => other.intersect_p(ray, t_max),
+        }
     }
 
     /// True when the ray hits the shape for some `t ∈ (0, t_max)`.

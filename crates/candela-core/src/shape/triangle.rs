@@ -44,8 +44,83 @@ const DEFAULT_UV: [Vec2; 3] = [
     Vec2::new(1.0, 1.0),
 ];
 
-/// Watertight ray–triangle test; `None` unless the hit has `t ∈ (0, t_max)`
-/// conservatively [Woop et al. 2013; pbrt-v4 §6.5.3].
+/// Per-ray constants of the watertight test (axis permutation and shear),
+/// computed once per ray and reused for every triangle it meets.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    o: Vec3,
+    k: [usize; 3],
+    s: Vec3,
+}
+
+impl WatertightRay {
+    /// Precomputes the permutation (z = dominant axis) and shear of `ray`.
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let kz = max_dimension(ray.d.abs());
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let d = Vec3::new(ray.d[kx], ray.d[ky], ray.d[kz]);
+        let sz = 1.0 / d.z;
+        Self {
+            o: ray.o,
+            k: [kx, ky, kz],
+            s: Vec3::new(-d.x * sz, -d.y * sz, sz),
+        }
+    }
+
+    /// Watertight ray–triangle test; `None` unless the hit has `t ∈ (0, t_max)`
+    /// conservatively [Woop et al. 2013; pbrt-v4 §6.5.3].
+    #[inline]
+    pub fn intersect(
+        &self,
+        t_max: f32,
+        p0: Vec3,
+        p1: Vec3,
+        p2: Vec3,
+    ) -> Option<TriangleIntersection> {
+        // Translate to the ray origin, permute so z is the dominant axis, shear x and y.
+        let [kx, ky, kz] = self.k;
+        let mut pt = [p0, p1, p2].map(|p| {
+            let q = p - self.o;
+            let z = q[kz];
+            Vec3::new(q[kx] + self.s.x * z, q[ky] + self.s.y * z, z)
+        });
+        let mut e = edge_functions(&pt);
+        if e.contains(&0.0) {
+            e = edge_functions_f64(&pt);
+        }
+        let any_neg = e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0;
+        let any_pos = e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0;
+        if any_neg && any_pos {
+            return None;
+        }
+        let det = e[0] + e[1] + e[2];
+        if det == 0.0 {
+            return None;
+        }
+        for p in pt.iter_mut() {
+            p.z *= self.s.z;
+        }
+        // Scaled t test avoids the division for most misses.
+        let t_scaled = e[0] * pt[0].z + e[1] * pt[1].z + e[2] * pt[2].z;
+        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+            return None;
+        }
+        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let b = [e[0] * inv_det, e[1] * inv_det, e[2] * inv_det];
+        let t = t_scaled * inv_det;
+        if t <= t_error_bound(&pt, &e, inv_det) {
+            return None;
+        }
+        Some(TriangleIntersection { b, t })
+    }
+}
+
+/// Watertight ray–triangle test for a single triangle (see [`WatertightRay`]).
 pub fn intersect_triangle(
     ray: &Ray,
     t_max: f32,
@@ -53,51 +128,7 @@ pub fn intersect_triangle(
     p1: Vec3,
     p2: Vec3,
 ) -> Option<TriangleIntersection> {
-    // Translate to the ray origin, permute so z is the dominant axis.
-    let kz = max_dimension(ray.d.abs());
-    let kx = (kz + 1) % 3;
-    let ky = (kx + 1) % 3;
-    let perm = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
-    let d = perm(ray.d);
-    let mut pt = [p0, p1, p2].map(|p| perm(p - ray.o));
-    // Shear so the ray runs along +z (z is sheared lazily below).
-    let sz = 1.0 / d.z;
-    let (sx, sy) = (-d.x * sz, -d.y * sz);
-    for p in pt.iter_mut() {
-        p.x += sx * p.z;
-        p.y += sy * p.z;
-    }
-    let mut e = edge_functions(&pt);
-    if e.contains(&0.0) {
-        e = edge_functions_f64(&pt);
-    }
-    let any_neg = e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0;
-    let any_pos = e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0;
-    if any_neg && any_pos {
-        return None;
-    }
-    let det = e[0] + e[1] + e[2];
-    if det == 0.0 {
-        return None;
-    }
-    for p in pt.iter_mut() {
-        p.z *= sz;
-    }
-    // Scaled t test avoids the division for most misses.
-    let t_scaled = e[0] * pt[0].z + e[1] * pt[1].z + e[2] * pt[2].z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let b = [e[0] * inv_det, e[1] * inv_det, e[2] * inv_det];
-    let t = t_scaled * inv_det;
-    if t <= t_error_bound(&pt, &e, inv_det) {
-        return None;
-    }
-    Some(TriangleIntersection { b, t })
+    WatertightRay::new(ray).intersect(t_max, p0, p1, p2)
 }
 
 /// Index of the largest component.
@@ -190,6 +221,13 @@ impl Triangle {
         Some(ShapeIntersection { si, t_hit: ti.t })
     }
 
+    /// The raw hit (t and barycentrics) for a precomputed ray, without building the interaction.
+    #[inline]
+    pub fn intersect_raw(&self, wr: &WatertightRay, t_max: f32) -> Option<TriangleIntersection> {
+        let [p0, p1, p2] = self.positions();
+        wr.intersect(t_max, p0, p1, p2)
+    }
+
     /// True when the ray hits for some `t ∈ (0, t_max)`.
     pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
         let [p0, p1, p2] = self.positions();
@@ -231,7 +269,7 @@ impl Triangle {
     }
 
     /// Builds the surface interaction of a hit [pbrt-v4 §6.5.4].
-    fn interaction(&self, ti: &TriangleIntersection, wo: Vec3) -> SurfaceInteraction {
+    pub(crate) fn interaction(&self, ti: &TriangleIntersection, wo: Vec3) -> SurfaceInteraction {
         let [p0, p1, p2] = self.positions();
         let uv = self.uvs();
         let (dpdu, dpdv) = position_derivatives([p0, p1, p2], uv);

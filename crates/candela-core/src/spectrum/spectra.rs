@@ -12,13 +12,26 @@ use std::sync::Arc;
 pub struct PiecewiseLinear {
     lambda: Vec<f32>,
     values: Vec<f32>,
+    /// (first λ, 1/step) when the samples are evenly spaced: O(1) lookup.
+    even: Option<(f32, f32)>,
 }
 
 impl PiecewiseLinear {
     /// From sorted pairs.
     pub fn new(pairs: &[(f32, f32)]) -> Self {
+        let lambda: Vec<f32> = pairs.iter().map(|p| p.0).collect();
+        let step = if lambda.len() > 1 {
+            lambda[1] - lambda[0]
+        } else {
+            0.0
+        };
+        let is_even = step > 0.0
+            && lambda
+                .windows(2)
+                .all(|w| ((w[1] - w[0]) - step).abs() <= 1e-4 * step);
         Self {
-            lambda: pairs.iter().map(|p| p.0).collect(),
+            even: is_even.then(|| (lambda[0], 1.0 / step)),
+            lambda,
             values: pairs.iter().map(|p| p.1).collect(),
         }
     }
@@ -27,6 +40,7 @@ impl PiecewiseLinear {
         Self {
             lambda: (0..values.len()).map(|i| start + step * i as f32).collect(),
             values: values.to_vec(),
+            even: (step > 0.0).then(|| (start, 1.0 / step)),
         }
     }
     /// Value at `l`.
@@ -35,7 +49,13 @@ impl PiecewiseLinear {
         if n == 0 || l < self.lambda[0] || l > self.lambda[n - 1] {
             return 0.0;
         }
-        let i = self.lambda.partition_point(|&x| x <= l).clamp(1, n - 1) - 1;
+        let i = match self.even {
+            Some((start, inv_step)) => (((l - start) * inv_step) as usize).min(n.saturating_sub(2)),
+            None => self.lambda.partition_point(|&x| x <= l).clamp(1, n - 1) - 1,
+        };
+        if n == 1 {
+            return self.values[0];
+        }
         let (l0, l1) = (self.lambda[i], self.lambda[i + 1]);
         let t = if l1 > l0 { (l - l0) / (l1 - l0) } else { 0.0 };
         self.values[i] + t * (self.values[i + 1] - self.values[i])
