@@ -108,3 +108,38 @@ AttributeEnd
     let img = render_str(scene, &ov(16));
     assert_region(&img, (0, 24, 0, 16), 2.0, 2e-3 * 2.0, "T7 emitter");
 }
+
+/// A diffuse sphere of albedo 0.5 under a uniform environment of radiance 1,
+/// optionally placed through an object instance.
+fn env_scene(instanced: bool) -> String {
+    let sphere = "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\nShape \"sphere\" \"float radius\" [1]\n";
+    let body = if instanced {
+        format!("ObjectBegin \"ball\"\n{sphere}ObjectEnd\nAttributeBegin\nTranslate 0 0 0\nObjectInstance \"ball\"\nAttributeEnd\n")
+    } else {
+        sphere.to_string()
+    };
+    format!(
+        r#"LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective" "float fov" [30]
+Film "rgb" "integer xresolution" [32] "integer yresolution" [32]
+PixelFilter "box"
+Sampler "independent"
+Integrator "path" "integer maxdepth" [50]
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+{body}"#
+    )
+}
+
+#[test]
+fn t4d_convex_lambertian_object_under_uniform_sky_renders_its_albedo() {
+    // validation.md T4(d): L_sky = 1 everywhere; a convex Lambertian object of
+    // albedo ρ reflects ρ·E/π = ρ (it sees the whole unoccluded hemisphere);
+    // rays missing it see the sky, 1. The object's silhouette at 30° fov over
+    // 5 units covers the central 12×12 pixels entirely.
+    for instanced in [false, true] {
+        let img = render_str(&env_scene(instanced), &ov(64));
+        assert_region(&img, (10, 22, 10, 22), 0.5, 2e-3 * 0.5, "T4d sphere");
+        assert_region(&img, (0, 3, 0, 3), 1.0, 2e-3, "T4d sky");
+    }
+}
