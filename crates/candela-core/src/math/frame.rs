@@ -25,7 +25,7 @@ impl Frame {
     pub fn from_xz(t: Vec3, n: Vec3) -> Self {
         let x = t - n * n.dot(t);
         let len = x.length();
-        if !(len > 1e-12) || !len.is_finite() {
+        if len.is_nan() || len <= 1e-12 || !len.is_finite() {
             return Self::from_z(n);
         }
         let x = x / len;

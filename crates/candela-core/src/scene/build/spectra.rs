@@ -58,7 +58,7 @@ pub fn spectrum_param(
             }
         }
         ParamSpectrum::Value(SpectrumValue::Blackbody(t)) => {
-            if !(t > 0.0) {
+            if t.is_nan() || t <= 0.0 {
                 return Err(BuildError::at(
                     &loc,
                     format!("\"{name}\": blackbody temperature must be positive, found {t}"),
