@@ -28,7 +28,7 @@ fn cornell_box_matches_pbrt_v4_reference() {
     };
     setup.integrator.render(&ctx, &mut setup.film);
     assert_eq!(setup.film.dropped_samples(), 0, "non-finite samples");
-    let img = setup.film.image(1.0);
+    let img = setup.film.image();
     let reference =
         RgbImage::read_exr(&root.join("reference-pbrt-v4-path-1024spp.exr")).expect("reference");
     let c = compare(&img, &reference).expect("same size");

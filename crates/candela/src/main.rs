@@ -101,7 +101,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let t1 = Instant::now();
     setup.integrator.render(&ctx, &mut setup.film);
     let render_time = t1.elapsed();
-    let image = setup.film.image(1.0);
+    let image = setup.film.image();
     let exr = setup.outfile.clone();
     write_outputs(&image, &exr)?;
     if setup.film.dropped_samples() > 0 {

@@ -4,4 +4,4 @@
 pub mod filter;
 mod rgb_film;
 
-pub use rgb_film::{FilmSettings, FilmTile, RgbFilm};
+pub use rgb_film::{FilmSettings, FilmTile, RgbFilm, SplatBuffer};

@@ -39,7 +39,47 @@ pub struct RgbFilm {
     output_from_sensor: Mat3,
     pixels: Vec<Pixel>,
     splats: Vec<[f64; 3]>,
+    splat_scale: f64,
     dropped_samples: u64,
+}
+
+/// Light-tracing splats of one batch of paths over the full raster; merged
+/// into the film in a fixed order so results do not depend on scheduling.
+pub struct SplatBuffer {
+    res: UVec2,
+    lo: UVec2,
+    hi: UVec2,
+    sums: Vec<[f64; 3]>,
+    sensor: PixelSensor,
+    max_component_value: f32,
+    dropped_samples: u64,
+}
+
+impl SplatBuffer {
+    /// Adds radiance-weighted importance `l` at raster position `p`
+    /// (ignored outside the rendered pixel bounds; non-finite values are dropped and counted).
+    pub fn add(&mut self, p: crate::math::Vec2, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        if l.has_non_finite() {
+            self.dropped_samples += 1;
+            return;
+        }
+        let (x, y) = (p.x.floor(), p.y.floor());
+        if !(x >= self.lo.x as f32
+            && y >= self.lo.y as f32
+            && x < self.hi.x as f32
+            && y < self.hi.y as f32)
+        {
+            return;
+        }
+        let rgb = clamp_rgb(
+            self.sensor.to_sensor_rgb(l, lambda),
+            self.max_component_value,
+        );
+        let s = &mut self.sums[(y as u32 * self.res.x + x as u32) as usize];
+        for (c, v) in rgb.iter().enumerate() {
+            s[c] += *v as f64;
+        }
+    }
 }
 
 /// The part of the film one thread renders; merged back with [`RgbFilm::merge_tile`].
@@ -68,6 +108,7 @@ impl RgbFilm {
             output_from_sensor,
             pixels: vec![Pixel::default(); n],
             splats: vec![[0.0; 3]; n],
+            splat_scale: 1.0,
             dropped_samples: 0,
         }
     }
@@ -122,34 +163,38 @@ impl RgbFilm {
         self.dropped_samples += tile.dropped_samples;
     }
 
-    /// Adds an unfiltered splat (light tracing) at raster position `p`.
-    pub fn add_splat(
-        &mut self,
-        p: crate::math::Vec2,
-        l: SampledSpectrum,
-        lambda: &SampledWavelengths,
-    ) {
-        if l.has_non_finite() {
-            self.dropped_samples += 1;
-            return;
-        }
+    /// An empty splat buffer for one batch of light paths.
+    pub fn splat_buffer(&self) -> SplatBuffer {
         let (lo, hi) = self.settings.pixel_bounds;
-        let (x, y) = (p.x.floor(), p.y.floor());
-        if x < lo.x as f32 || y < lo.y as f32 || x >= hi.x as f32 || y >= hi.y as f32 {
-            return;
-        }
-        let rgb = clamp_rgb(
-            self.sensor.to_sensor_rgb(l, lambda),
-            self.settings.max_component_value,
-        );
-        let s = &mut self.splats[(y as u32 * self.settings.resolution.x + x as u32) as usize];
-        for c in 0..3 {
-            s[c] += rgb[c] as f64;
+        SplatBuffer {
+            res: self.settings.resolution,
+            lo,
+            hi,
+            sums: vec![[0.0; 3]; self.splats.len()],
+            sensor: self.sensor.clone(),
+            max_component_value: self.settings.max_component_value,
+            dropped_samples: 0,
         }
     }
 
-    /// The image in output RGB over the pixel bounds; splats are scaled by `splat_scale`.
-    pub fn image(&self, splat_scale: f64) -> RgbImage {
+    /// Adds a batch's splats (call in a fixed order for reproducible images).
+    pub fn merge_splats(&mut self, buf: SplatBuffer) {
+        for (d, s) in self.splats.iter_mut().zip(&buf.sums) {
+            for c in 0..3 {
+                d[c] += s[c];
+            }
+        }
+        self.dropped_samples += buf.dropped_samples;
+    }
+
+    /// Sets the factor splats are multiplied by on output (light tracing: 1/spp).
+    pub fn set_splat_scale(&mut self, s: f64) {
+        self.splat_scale = s;
+    }
+
+    /// The image in output RGB over the pixel bounds (filtered samples plus scaled splats).
+    pub fn image(&self) -> RgbImage {
+        let splat_scale = self.splat_scale;
         let (lo, hi) = self.settings.pixel_bounds;
         let mut img = RgbImage::new((hi.x - lo.x) as usize, (hi.y - lo.y) as usize);
         for y in lo.y..hi.y {

@@ -6,8 +6,10 @@
 //! of driver / per-path tracer / settings).
 
 pub mod driver;
+mod light_tracer;
 mod path;
 
+pub use light_tracer::LightTracer;
 pub use path::{PathIntegrator, PathSettings};
 
 use crate::camera::Camera;

@@ -22,7 +22,7 @@ pub fn render_str(text: &str, ov: &Overrides) -> RgbImage {
         0,
         "non-finite samples were produced"
     );
-    setup.film.image(1.0)
+    setup.film.image()
 }
 
 /// Mean and standard error of the mean of channel `c` over pixels in `[x0,x1)×[y0,y1)`.

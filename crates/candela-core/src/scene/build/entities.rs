@@ -4,7 +4,7 @@ use super::{BuildError, Overrides};
 use crate::camera::{Camera, CameraParams};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{FilmSettings, RgbFilm};
-use crate::integrator::{Integrator, PathIntegrator, PathSettings};
+use crate::integrator::{Integrator, LightTracer, PathIntegrator, PathSettings};
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::spectrum::{ColorSpace, PixelSensor};
@@ -260,13 +260,21 @@ pub fn integrator(
         }
     };
     match name.as_str() {
+        "lightpath" => {
+            let seed = match (ov.seed, &desc.sampler) {
+                (Some(s), _) => s,
+                (None, Some(e)) => e.params.get_int("seed", 0)? as u64,
+                (None, None) => 0,
+            };
+            return Ok((Box::new(LightTracer { max_depth, seed }), name, power));
+        }
         "path" => {}
         "volpath" => warnings.push(format!(
             "{}: integrator \"volpath\" rendered with \"path\" (participating media are not supported yet; identical without media)",
             e.loc
         )),
         other => {
-            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath)")));
+            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath)")));
         }
     }
     let settings = PathSettings {
