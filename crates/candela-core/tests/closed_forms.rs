@@ -88,24 +88,29 @@ Shape "sphere" "float radius" [1]
     assert_region(&img, (0, 32, 0, 32), 5.0, 2e-3 * 5.0, "T4a furnace");
 }
 
-#[test]
-fn t7_emitter_filling_the_view_renders_its_radiance() {
-    // A Lambertian emitter of L = 2 covering the whole view: every pixel is 2.
-    let scene = r#"LookAt 0 0 0  0 0 1  0 1 0
+/// A Lambertian emitter of L = 2 (black albedo) filling a 40° view.
+fn emitter_scene(integrator: &str) -> String {
+    format!(
+        r#"LookAt 0 0 0  0 0 1  0 1 0
 Camera "perspective" "float fov" [40]
 Film "rgb" "integer xresolution" [24] "integer yresolution" [16]
 PixelFilter "box"
 Sampler "independent"
-Integrator "path" "integer maxdepth" [5]
+Integrator "{integrator}" "integer maxdepth" [5]
 WorldBegin
-AttributeBegin
 Material "diffuse" "rgb reflectance" [0 0 0]
 AreaLightSource "diffuse" "rgb L" [2 2 2]
 Shape "trianglemesh" "point3 P" [-10 -10 5  10 -10 5  10 10 5  -10 10 5] "integer indices" [0 1 2 0 2 3]
     "normal N" [0 0 -1 0 0 -1 0 0 -1 0 0 -1]
-AttributeEnd
-"#;
-    let img = render_str(scene, &ov(16));
+"#
+    )
+}
+
+#[test]
+fn t7_emitter_filling_the_view_renders_its_radiance() {
+    // A Lambertian emitter of L = 2 covering the whole view: every pixel is 2.
+    let scene = emitter_scene("path");
+    let img = render_str(&scene, &ov(16));
     assert_region(&img, (0, 24, 0, 16), 2.0, 2e-3 * 2.0, "T7 emitter");
 }
 
@@ -158,18 +163,8 @@ fn t7_light_tracer_splats_the_emitter_radiance() {
     // validation.md T7 through the light tracer: the emitter (L = 2) filling
     // the view is seen only by s = 1 connections (light point → lens), which
     // exercises β₀, We, the camera's pdf and the 1/spp splat scale together.
-    let scene = r#"LookAt 0 0 0  0 0 1  0 1 0
-Camera "perspective" "float fov" [40]
-Film "rgb" "integer xresolution" [24] "integer yresolution" [16]
-Sampler "independent"
-Integrator "lightpath" "integer maxdepth" [5]
-WorldBegin
-Material "diffuse" "rgb reflectance" [0 0 0]
-AreaLightSource "diffuse" "rgb L" [2 2 2]
-Shape "trianglemesh" "point3 P" [-10 -10 5  10 -10 5  10 10 5  -10 10 5] "integer indices" [0 1 2 0 2 3]
-    "normal N" [0 0 -1 0 0 -1 0 0 -1 0 0 -1]
-"#;
-    let img = render_str(scene, &lightpath(512));
+    let scene = emitter_scene("lightpath");
+    let img = render_str(&scene, &lightpath(512));
     assert_region(&img, (0, 24, 0, 16), 2.0, 2e-3 * 2.0, "T7 light tracer");
 }
 
