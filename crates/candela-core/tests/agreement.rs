@@ -1,0 +1,141 @@
+//! Integrators agree (validation.md, "Integrators agree"): the path tracer
+//! and the light tracer render the same small Cornell box, and every 8×8
+//! block's mean is compared with Welch's t-test [Jung, Hanika & Dachsbacher,
+//! JCGT 2020]. Each integrator renders K independent seeds, so every block
+//! has K independent estimates per integrator; the test fails if any block's
+//! two-sided p-value is below the Šidák-corrected α' for α = 0.01 over all
+//! blocks. A bias of a few per cent in any region fails it.
+
+mod common;
+
+use candela_core::image::RgbImage;
+use candela_core::scene::build::Overrides;
+use common::render_str;
+
+const K: usize = 8;
+const RES: usize = 32;
+const BLOCK: usize = 8;
+
+fn cornell_small() -> String {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/cornell-box/scene.pbrt"
+    ))
+    .expect("bundled scene");
+    text.replace(
+        "\"integer xresolution\" [256] \"integer yresolution\" [256]",
+        "\"integer xresolution\" [32] \"integer yresolution\" [32]",
+    )
+    .replace("\"integer maxdepth\" [100]", "\"integer maxdepth\" [8]")
+}
+
+/// Block means (luminance-like sum of channels) of K renders.
+fn block_means(integrator: &str, spp: u32) -> Vec<Vec<f64>> {
+    let scene = cornell_small();
+    assert!(scene.contains("[32]"), "resolution override did not apply");
+    let nb = RES / BLOCK;
+    let mut out = vec![Vec::with_capacity(K); nb * nb];
+    for k in 0..K {
+        let ov = Overrides {
+            spp: Some(spp),
+            seed: Some(100 + k as u64),
+            integrator: Some(integrator.into()),
+            ..Default::default()
+        };
+        let img: RgbImage = render_str(&scene, &ov);
+        for by in 0..nb {
+            for bx in 0..nb {
+                let mut s = 0.0f64;
+                for y in by * BLOCK..(by + 1) * BLOCK {
+                    for x in bx * BLOCK..(bx + 1) * BLOCK {
+                        let p = img.get(x, y);
+                        s += (p[0] + p[1] + p[2]) as f64;
+                    }
+                }
+                out[by * nb + bx].push(s / (BLOCK * BLOCK) as f64);
+            }
+        }
+    }
+    out
+}
+
+fn mean_var(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    (
+        m,
+        v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0),
+    )
+}
+
+/// Regularised incomplete beta I_x(a, b) by Lentz's continued fraction.
+fn inc_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    if x > (a + 1.0) / (a + b + 2.0) {
+        return 1.0 - inc_beta(b, a, 1.0 - x);
+    }
+    let ln_front =
+        a * x.ln() + b * (1.0 - x).ln() - (ln_gamma(a) + ln_gamma(b) - ln_gamma(a + b)) - a.ln();
+    let (tiny, mut f, mut c, mut d) = (1e-300, 1.0, 1.0, 0.0);
+    for i in 0..400 {
+        let m = (i / 2) as f64;
+        let num = if i == 0 {
+            1.0
+        } else if i % 2 == 0 {
+            m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m))
+        } else {
+            -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
+        };
+        d = 1.0 + num * d;
+        d = if d.abs() < tiny { tiny } else { d };
+        d = 1.0 / d;
+        c = 1.0 + num / c;
+        c = if c.abs() < tiny { tiny } else { c };
+        let cd = c * d;
+        f *= cd;
+        if (cd - 1.0).abs() < 1e-14 {
+            break;
+        }
+    }
+    ln_front.exp() * (f - 1.0)
+}
+
+fn ln_gamma(x: f64) -> f64 {
+    candela_core::sampling::chi2::ln_gamma(x)
+}
+
+/// Two-sided p-value of Student's t with `df` degrees of freedom.
+fn t_two_sided_p(t: f64, df: f64) -> f64 {
+    inc_beta(df / 2.0, 0.5, df / (df + t * t))
+}
+
+#[test]
+fn student_t_p_values_match_tables() {
+    // Two-sided critical values: t(10) = 2.228 at 0.05, t(5) = 4.032 at 0.01, t(30) = 2.750 at 0.01.
+    for (t, df, p) in [(2.228, 10.0, 0.05), (4.032, 5.0, 0.01), (2.750, 30.0, 0.01)] {
+        let got = t_two_sided_p(t, df);
+        assert!((got - p).abs() < 2e-4, "t={t} df={df}: {got}");
+    }
+}
+
+#[test]
+fn path_and_light_tracers_agree_per_block() {
+    let pt = block_means("path", 64);
+    let lt = block_means("lightpath", 64);
+    let m = pt.len();
+    let alpha = 1.0 - (1.0f64 - 0.01).powf(1.0 / m as f64);
+    for b in 0..m {
+        let ((mx, vx), (my, vy)) = (mean_var(&pt[b]), mean_var(&lt[b]));
+        let (sx, sy) = (vx / K as f64, vy / K as f64);
+        let t = (mx - my) / (sx + sy).sqrt();
+        // Welch–Satterthwaite degrees of freedom.
+        let df = (sx + sy).powi(2) / (sx * sx / (K as f64 - 1.0) + sy * sy / (K as f64 - 1.0));
+        let p = t_two_sided_p(t.abs(), df);
+        assert!(p >= alpha, "block {b}: PT {mx:.5} vs LT {my:.5}, t = {t:.2}, df = {df:.1}, p = {p:.2e} < {alpha:.2e}");
+    }
+}
