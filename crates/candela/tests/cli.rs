@@ -15,6 +15,7 @@ fn tmpdir(name: &str) -> PathBuf {
 }
 
 const SMALL: &str = r#"LookAt 0 0 -3  0 0 0  0 1 0
+Option "bool disablepixeljitter" true
 Camera "perspective" "float fov" [45] "float bogus" [1]
 Film "rgb" "integer xresolution" [16] "integer yresolution" [12]
 Sampler "independent" "integer pixelsamples" [4]
@@ -61,18 +62,18 @@ fn errors_name_file_line_column_and_exit_non_zero() {
     let cases = [
         (
             SMALL.replace("Shape \"sphere\"", "Shape \"hyperboloid\""),
-            ":9:1",
+            ":10:1",
             "hyperboloid",
         ),
         (
             SMALL.replace("\"float fov\" [45]", "\"float fov\" [\"wide\"]"),
-            ":2:",
+            ":3:",
             "fov",
         ),
-        (format!("{SMALL}Frobnicate 1 2 3\n"), ":10:1", "Frobnicate"),
+        (format!("{SMALL}Frobnicate 1 2 3\n"), ":11:1", "Frobnicate"),
         (
             SMALL.replace("Integrator \"path\"", "Integrator \"mlt\""),
-            ":5:1",
+            ":6:1",
             "mlt",
         ),
     ];

@@ -126,8 +126,24 @@ fn unused_of(params: &ParamSet, what: &str, warnings: &mut Vec<String>) {
     }
 }
 
-/// Reports every parameter that no builder looked at.
+/// Reports every parameter that no builder looked at, and directives that
+/// are read but have no effect yet (`Option`, `Accelerator`, unreferenced textures).
 fn collect_unused(desc: &SceneDescription, warnings: &mut Vec<String>) {
+    for (name, p) in &desc.options {
+        warnings.push(format!(
+            "{}: Option \"{name}\" is not supported yet and is ignored",
+            p.loc
+        ));
+    }
+    if let Some(a) = &desc.accelerator {
+        warnings.push(format!(
+            "{}: Accelerator \"{}\" ignored: candela always builds its SAH BVH",
+            a.loc, a.name
+        ));
+    }
+    for t in &desc.textures {
+        warnings.push(format!("{}: texture \"{}\" (\"{}\") is not supported yet; it is not used by any supported material", t.loc, t.name, t.class));
+    }
     for (e, what) in [
         (&desc.film, "Film"),
         (&desc.sampler, "Sampler"),
