@@ -163,10 +163,14 @@ fn diff(a: &Path, b: &Path) -> Result<()> {
         "channel", "mean A", "mean B", "A/B"
     );
     for (i, ch) in ["R", "G", "B"].iter().enumerate() {
-        println!(
-            "{:<10} {:>12.6} {:>12.6} {:>10.5}",
-            ch, ma[i], mb[i], c.mean_ratio[i]
-        );
+        // 0/0 (two black channels) has no ratio.
+        let r = c.mean_ratio[i];
+        let ratio = if r.is_finite() {
+            format!("{r:.5}")
+        } else {
+            "n/a".to_string()
+        };
+        println!("{:<10} {:>12.6} {:>12.6} {:>10}", ch, ma[i], mb[i], ratio);
     }
     println!("relMSE (eps 0.01)  {:.6}", c.rel_mse);
     println!("MAE                {:.6}", c.mae);
