@@ -54,7 +54,7 @@ fn default_entity(name: &str) -> Entity {
         name: name.to_string(),
         params: ParamSet::default(),
         color_space: "srgb".to_string(),
-        loc: Loc::file_only(std::path::Path::new("<default>")),
+        loc: Loc::file_only(std::path::Path::new("(pbrt-v4 default)")),
     }
 }
 
