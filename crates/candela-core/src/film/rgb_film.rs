@@ -45,12 +45,18 @@ pub struct RgbFilm {
 
 /// Light-tracing splats of one batch of paths over the full raster; merged
 /// into the film in a fixed order so results do not depend on scheduling.
+///
+/// As in pbrt-v4, a splat at raster position p adds f(p − c)/∫f to every
+/// pixel centre c within the filter's radius, so splatted and filtered
+/// camera samples reconstruct the same image.
 pub struct SplatBuffer {
     res: UVec2,
     lo: UVec2,
     hi: UVec2,
     sums: Vec<[f64; 3]>,
     sensor: PixelSensor,
+    filter: Filter,
+    inv_filter_integral: f32,
     max_component_value: f32,
     dropped_samples: u64,
 }
@@ -59,25 +65,53 @@ impl SplatBuffer {
     /// Adds radiance-weighted importance `l` at raster position `p`
     /// (ignored outside the rendered pixel bounds; non-finite values are dropped and counted).
     pub fn add(&mut self, p: crate::math::Vec2, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        if self.sums.is_empty() {
+            return;
+        }
         if l.has_non_finite() {
             self.dropped_samples += 1;
             return;
         }
-        let (x, y) = (p.x.floor(), p.y.floor());
-        if !(x >= self.lo.x as f32
-            && y >= self.lo.y as f32
-            && x < self.hi.x as f32
-            && y < self.hi.y as f32)
-        {
+        let r = self.filter.radius();
+        // Pixel centres within the radius: c = i + ½ with |p − c| ≤ r.
+        let x0 = ((p.x - 0.5 - r.x).ceil().max(self.lo.x as f32)) as i64;
+        let y0 = ((p.y - 0.5 - r.y).ceil().max(self.lo.y as f32)) as i64;
+        let x1 = ((p.x - 0.5 + r.x).floor().min(self.hi.x as f32 - 1.0)) as i64;
+        let y1 = ((p.y - 0.5 + r.y).floor().min(self.hi.y as f32 - 1.0)) as i64;
+        if x0 > x1 || y0 > y1 {
             return;
         }
         let rgb = clamp_rgb(
             self.sensor.to_sensor_rgb(l, lambda),
             self.max_component_value,
         );
-        let s = &mut self.sums[(y as u32 * self.res.x + x as u32) as usize];
-        for (c, v) in rgb.iter().enumerate() {
-            s[c] += *v as f64;
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let c = crate::math::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let w = self.filter.evaluate(p - c) * self.inv_filter_integral;
+                if w == 0.0 {
+                    continue;
+                }
+                let s = &mut self.sums[(y as u32 * self.res.x + x as u32) as usize];
+                for (c, v) in rgb.iter().enumerate() {
+                    s[c] += (w * *v) as f64;
+                }
+            }
+        }
+    }
+
+    /// A buffer that ignores every splat (for estimators that never splat).
+    pub fn disabled() -> Self {
+        Self {
+            res: UVec2::ZERO,
+            lo: UVec2::ZERO,
+            hi: UVec2::ZERO,
+            sums: Vec::new(),
+            sensor: PixelSensor::cie1931(1.0),
+            filter: Filter::default(),
+            inv_filter_integral: 0.0,
+            max_component_value: 0.0,
+            dropped_samples: 0,
         }
     }
 }
@@ -172,6 +206,8 @@ impl RgbFilm {
             hi,
             sums: vec![[0.0; 3]; self.splats.len()],
             sensor: self.sensor.clone(),
+            filter: self.filter.clone(),
+            inv_filter_integral: 1.0 / self.filter.integral(),
             max_component_value: self.settings.max_component_value,
             dropped_samples: 0,
         }
@@ -179,6 +215,9 @@ impl RgbFilm {
 
     /// Adds a batch's splats (call in a fixed order for reproducible images).
     pub fn merge_splats(&mut self, buf: SplatBuffer) {
+        if buf.sums.is_empty() {
+            return;
+        }
         for (d, s) in self.splats.iter_mut().zip(&buf.sums) {
             for c in 0..3 {
                 d[c] += s[c];

@@ -4,42 +4,75 @@
 //! pixel sample reseeds the sampler from (pixel, sample index, seed), and
 //! each pixel is written by exactly one tile, so the image is bit-identical
 //! for any thread count and schedule.
+//!
+//! Estimators that splat (BDPT's t = 1 strategies) write into one of
+//! [`LANES`] full-raster splat buffers: tile i goes to lane i mod LANES, the
+//! tiles of a lane run in order, and lanes are merged in order. The sum is
+//! therefore the same for any thread count too.
 
 use super::{PixelEstimator, RenderContext};
-use crate::film::{FilmTile, RgbFilm};
+use crate::camera::CameraSample;
+use crate::film::{FilmTile, RgbFilm, SplatBuffer};
 use crate::math::{UVec2, Vec2};
+use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
 use rayon::prelude::*;
 
 /// Tile side in pixels.
 pub const TILE: u32 = 16;
+/// Splat lanes (fixed, so splat sums do not depend on the thread count).
+pub const LANES: usize = 8;
 
 /// Renders every pixel of `film` with `estimator`.
 pub fn render_pixels(est: &dyn PixelEstimator, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-    let bounds = film.pixel_bounds();
+    let tiles = tiles(film.pixel_bounds());
+    let spp = ctx.sampler.samples_per_pixel();
+    ctx.progress
+        .start(tiles.len() as u64 * spp as u64, "tile·spp");
+    let splats = est.splats();
+    let lanes: Vec<(Vec<FilmTile>, SplatBuffer)> = (0..LANES)
+        .into_par_iter()
+        .map(|lane| {
+            let mut buf = if splats {
+                film.splat_buffer()
+            } else {
+                SplatBuffer::disabled()
+            };
+            let done: Vec<FilmTile> = tiles
+                .iter()
+                .skip(lane)
+                .step_by(LANES)
+                .map(|&(lo, hi)| {
+                    let tile = render_tile(est, ctx, film, lo, hi, &mut buf);
+                    ctx.progress.advance(spp as u64);
+                    tile
+                })
+                .collect();
+            (done, buf)
+        })
+        .collect();
+    for (done, buf) in lanes {
+        for tile in done {
+            film.merge_tile(tile);
+        }
+        film.merge_splats(buf);
+    }
+    if splats {
+        film.set_splat_scale(1.0 / spp as f64);
+    }
+    ctx.progress.finish();
+}
+
+/// The 16×16 tiles covering the pixel bounds, in scanline order.
+fn tiles(bounds: (UVec2, UVec2)) -> Vec<(UVec2, UVec2)> {
     let (w, h) = (bounds.1.x - bounds.0.x, bounds.1.y - bounds.0.y);
-    let tiles: Vec<(UVec2, UVec2)> = (0..h.div_ceil(TILE))
+    (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
         .map(|(tx, ty)| {
             let lo = bounds.0 + UVec2::new(tx * TILE, ty * TILE);
             (lo, (lo + UVec2::splat(TILE)).min(bounds.1))
         })
-        .collect();
-    let spp = ctx.sampler.samples_per_pixel();
-    ctx.progress
-        .start(tiles.len() as u64 * spp as u64, "tile·spp");
-    let done: Vec<FilmTile> = tiles
-        .par_iter()
-        .map(|&(lo, hi)| {
-            let tile = render_tile(est, ctx, film, lo, hi);
-            ctx.progress.advance(spp as u64);
-            tile
-        })
-        .collect();
-    for tile in done {
-        film.merge_tile(tile);
-    }
-    ctx.progress.finish();
+        .collect()
 }
 
 fn render_tile(
@@ -48,6 +81,7 @@ fn render_tile(
     film: &RgbFilm,
     lo: UVec2,
     hi: UVec2,
+    splats: &mut SplatBuffer,
 ) -> FilmTile {
     let mut tile = film.tile(lo, hi);
     let mut sampler = ctx.sampler.clone();
@@ -56,7 +90,7 @@ fn render_tile(
             let pixel = UVec2::new(x, y);
             for index in 0..sampler.samples_per_pixel() {
                 sampler.start_pixel_sample(pixel, index, 0);
-                render_sample(est, ctx, film, &mut tile, pixel, &mut sampler);
+                render_sample(est, ctx, film, &mut tile, pixel, &mut sampler, splats);
             }
         }
     }
@@ -69,19 +103,17 @@ fn render_sample(
     film: &RgbFilm,
     tile: &mut FilmTile,
     pixel: UVec2,
-    sampler: &mut crate::sampler::Sampler,
+    sampler: &mut Sampler,
+    splats: &mut SplatBuffer,
 ) {
     // Sample order follows pbrt-v4's GetCameraSample: wavelengths, filter, lens.
     let mut lambda = SampledWavelengths::sample_visible(sampler.get_1d());
     let fs = film.filter().sample(sampler.get_pixel_2d());
     let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
     let p_lens = sampler.get_2d();
-    let Some(cr) = ctx
-        .camera
-        .generate_ray(crate::camera::CameraSample { p_film, p_lens })
-    else {
+    let Some(cr) = ctx.camera.generate_ray(CameraSample { p_film, p_lens }) else {
         return;
     };
-    let l = est.li(ctx.scene, cr.ray, &mut lambda, sampler) * cr.weight;
+    let l = est.li(ctx, cr.ray, &mut lambda, sampler, splats) * cr.weight;
     tile.add_sample(pixel, l, &lambda, fs.weight);
 }

@@ -11,7 +11,7 @@
 
 use super::{driver, Integrator, PixelEstimator, RenderContext};
 use crate::bsdf::{BsdfSample, SampleFlags, TransportMode};
-use crate::film::RgbFilm;
+use crate::film::{RgbFilm, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
 use crate::light::{LightSampleContext, LightType};
 use crate::math::Ray;
@@ -68,11 +68,13 @@ struct PathState {
 impl PixelEstimator for PathIntegrator {
     fn li(
         &self,
-        scene: &Scene,
+        ctx: &RenderContext<'_>,
         mut ray: Ray,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        _splats: &mut SplatBuffer,
     ) -> SampledSpectrum {
+        let scene = ctx.scene;
         let mut st = PathState {
             l: SampledSpectrum::zero(),
             beta: SampledSpectrum::one(),
