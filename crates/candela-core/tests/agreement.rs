@@ -1,5 +1,6 @@
-//! Integrators agree (validation.md, "Integrators agree"): the path tracer
-//! and the light tracer render the same small Cornell box, and every 8×8
+//! Integrators agree (validation.md, "Integrators agree"): the path tracer,
+//! the light tracer and BDPT render the same small Cornell box and an
+//! off-centre sphere furnace, and every 8×8
 //! block's mean is compared with Welch's t-test [Jung, Hanika & Dachsbacher,
 //! JCGT 2020]. Each integrator renders K independent seeds, so every block
 //! has K independent estimates per integrator; the test fails if any block's
@@ -29,9 +30,27 @@ fn cornell_small() -> String {
     .replace("\"integer maxdepth\" [100]", "\"integer maxdepth\" [8]")
 }
 
+/// validation.md T4(b) off-centre: a point light at (0, 0, 0.5) inside a
+/// diffuse sphere (ρ = 0.5, R = 1) seen from the centre, so radiance varies
+/// over the image.
+fn sphere_furnace() -> String {
+    r#"LookAt 0 0 0  0 0.3 1  0 1 0
+Camera "perspective" "float fov" [70]
+Film "rgb" "integer xresolution" [32] "integer yresolution" [32]
+PixelFilter "box"
+Sampler "independent"
+Integrator "path" "integer maxdepth" [50]
+WorldBegin
+LightSource "point" "point3 from" [0 0 0.5] "rgb I" [1 1 1]
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+ReverseOrientation
+Shape "sphere" "float radius" [1]
+"#
+    .to_string()
+}
+
 /// Block means (luminance-like sum of channels) of K renders.
-fn block_means(integrator: &str, spp: u32) -> Vec<Vec<f64>> {
-    let scene = cornell_small();
+fn block_means(scene: &str, integrator: &str, spp: u32) -> Vec<Vec<f64>> {
     assert!(scene.contains("[32]"), "resolution override did not apply");
     let nb = RES / BLOCK;
     let mut out = vec![Vec::with_capacity(K); nb * nb];
@@ -42,7 +61,7 @@ fn block_means(integrator: &str, spp: u32) -> Vec<Vec<f64>> {
             integrator: Some(integrator.into()),
             ..Default::default()
         };
-        let img: RgbImage = render_str(&scene, &ov);
+        let img: RgbImage = render_str(scene, &ov);
         for by in 0..nb {
             for bx in 0..nb {
                 let mut s = 0.0f64;
@@ -123,19 +142,40 @@ fn student_t_p_values_match_tables() {
     }
 }
 
-#[test]
-fn path_and_light_tracers_agree_per_block() {
-    let pt = block_means("path", 64);
-    let lt = block_means("lightpath", 64);
-    let m = pt.len();
+/// Welch's t-test per block between two integrators' K renders; fails on
+/// any block below the Šidák-corrected level for α = 0.01 overall.
+fn assert_agree(a: &[Vec<f64>], b: &[Vec<f64>], what: &str) {
+    let m = a.len();
     let alpha = 1.0 - (1.0f64 - 0.01).powf(1.0 / m as f64);
-    for b in 0..m {
-        let ((mx, vx), (my, vy)) = (mean_var(&pt[b]), mean_var(&lt[b]));
+    for blk in 0..m {
+        let ((mx, vx), (my, vy)) = (mean_var(&a[blk]), mean_var(&b[blk]));
         let (sx, sy) = (vx / K as f64, vy / K as f64);
         let t = (mx - my) / (sx + sy).sqrt();
         // Welch–Satterthwaite degrees of freedom.
         let df = (sx + sy).powi(2) / (sx * sx / (K as f64 - 1.0) + sy * sy / (K as f64 - 1.0));
         let p = t_two_sided_p(t.abs(), df);
-        assert!(p >= alpha, "block {b}: PT {mx:.5} vs LT {my:.5}, t = {t:.2}, df = {df:.1}, p = {p:.2e} < {alpha:.2e}");
+        assert!(p >= alpha, "{what}, block {blk}: {mx:.5} vs {my:.5}, t = {t:.2}, df = {df:.1}, p = {p:.2e} < {alpha:.2e}");
     }
+}
+
+#[test]
+fn path_light_and_bidirectional_tracers_agree_on_the_cornell_box() {
+    let scene = cornell_small();
+    let pt = block_means(&scene, "path", 64);
+    let lt = block_means(&scene, "lightpath", 64);
+    let bd = block_means(&scene, "bdpt", 16);
+    assert_agree(&pt, &lt, "Cornell PT vs LT");
+    assert_agree(&pt, &bd, "Cornell PT vs BDPT");
+    assert_agree(&lt, &bd, "Cornell LT vs BDPT");
+}
+
+#[test]
+fn path_light_and_bidirectional_tracers_agree_in_the_sphere_furnace() {
+    let scene = sphere_furnace();
+    let pt = block_means(&scene, "path", 16);
+    let lt = block_means(&scene, "lightpath", 16);
+    let bd = block_means(&scene, "bdpt", 8);
+    assert_agree(&pt, &lt, "furnace PT vs LT");
+    assert_agree(&pt, &bd, "furnace PT vs BDPT");
+    assert_agree(&lt, &bd, "furnace LT vs BDPT");
 }

@@ -39,6 +39,17 @@ pub enum TransportMode {
     Importance,
 }
 
+impl TransportMode {
+    /// The adjoint mode: what the walker from the other end carries.
+    #[inline]
+    pub fn flip(self) -> Self {
+        match self {
+            TransportMode::Radiance => TransportMode::Importance,
+            TransportMode::Importance => TransportMode::Radiance,
+        }
+    }
+}
+
 bitflags! {
     /// Lobe classification of a BxDF or of one sample.
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

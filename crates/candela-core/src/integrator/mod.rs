@@ -5,15 +5,17 @@
 //! threads, tiles, progress and deterministic accumulation (Tungsten's split
 //! of driver / per-path tracer / settings).
 
+mod bdpt;
 pub mod driver;
 mod light_tracer;
 mod path;
 
+pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic};
 pub use light_tracer::LightTracer;
 pub use path::{PathIntegrator, PathSettings};
 
 use crate::camera::Camera;
-use crate::film::RgbFilm;
+use crate::film::{RgbFilm, SplatBuffer};
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -58,12 +60,20 @@ pub trait Integrator: Send + Sync {
 
 /// A camera-driven estimator: the radiance arriving along one camera ray.
 pub trait PixelEstimator: Send + Sync {
-    /// Estimates the incident radiance along `ray` for the wavelengths `lambda`.
+    /// Estimates the incident radiance along `ray` for the wavelengths
+    /// `lambda`; estimators that connect to the camera add those
+    /// contributions to `splats` (scaled by 1/spp on output).
     fn li(
         &self,
-        scene: &Scene,
+        ctx: &RenderContext<'_>,
         ray: Ray,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        splats: &mut SplatBuffer,
     ) -> SampledSpectrum;
+
+    /// True when [`PixelEstimator::li`] splats (the driver then allocates splat buffers).
+    fn splats(&self) -> bool {
+        false
+    }
 }

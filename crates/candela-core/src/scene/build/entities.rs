@@ -4,7 +4,9 @@ use super::{BuildError, Overrides};
 use crate::camera::{Camera, CameraParams};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{FilmSettings, RgbFilm};
-use crate::integrator::{Integrator, LightTracer, PathIntegrator, PathSettings};
+use crate::integrator::{
+    BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings,
+};
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::spectrum::{ColorSpace, PixelSensor};
@@ -268,13 +270,29 @@ pub fn integrator(
             };
             return Ok((Box::new(LightTracer { max_depth, seed }), name, power));
         }
+        "bdpt" => {
+            for flag in ["visualizestrategies", "visualizeweights"] {
+                if p.get_bool(flag, false)? {
+                    return Err(BuildError::at(
+                        p.param_loc(flag).unwrap_or(&e.loc),
+                        format!("bdpt \"{flag}\" is not supported yet"),
+                    ));
+                }
+            }
+            let settings = BdptSettings {
+                max_depth,
+                regularize,
+                ..BdptSettings::default()
+            };
+            return Ok((Box::new(BdptIntegrator { settings }), name, power));
+        }
         "path" => {}
         "volpath" => warnings.push(format!(
             "{}: integrator \"volpath\" rendered with \"path\" (participating media are not supported yet; identical without media)",
             e.loc
         )),
         other => {
-            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath)")));
+            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath, bdpt)")));
         }
     }
     let settings = PathSettings {

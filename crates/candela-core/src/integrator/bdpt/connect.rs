@@ -1,0 +1,285 @@
+//! `connect`: joins the first s light vertices with the first t camera
+//! vertices and returns the path's unweighted contribution and its MIS
+//! weight [Veach 1997, §10.2; pbrt-v3 `ConnectBDPT`].
+//!
+//! Four cases:
+//! - s = 0: the camera subpath ends on an emitter; C = β_E·Le.
+//! - t = 1: a lens point is sampled and the light vertex is splatted onto
+//!   the film (light tracing): C = β_L·f̂_L·We/p(ω).
+//! - s = 1: a light point is sampled for the camera vertex (next-event
+//!   estimation): C = β_E·f·|cos|·Li/(p_light·p(ω)).
+//! - otherwise: C = β_L·f̂_L·f_E|cos_E|·β_E/d², with visibility.
+//!
+//! f̂_L = f·|ωo·ns||ωi·ng|/|ωo·ng| is the light-side BSDF with the adjoint
+//! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
+
+use super::mis::{mis_weight, MisHeuristic, PathView};
+use super::vertex::{emitted, pdf_light_origin, Vertex, VertexKind};
+use crate::bsdf::TransportMode;
+use crate::camera::Camera;
+use crate::interaction::Interaction;
+use crate::light::{LightSampleContext, LightType};
+use crate::math::{Vec2, Vec3};
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// One strategy's result.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Contribution {
+    /// Contribution before MIS weighting.
+    pub unweighted: SampledSpectrum,
+    /// MIS-weighted contribution.
+    pub weighted: SampledSpectrum,
+    /// Raster position for t = 1 (splat), `None` for the current pixel.
+    pub p_raster: Option<Vec2>,
+}
+
+/// What every connection needs.
+pub(crate) struct ConnectCtx<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The camera.
+    pub camera: &'a Camera,
+    /// Path wavelengths.
+    pub lambda: &'a SampledWavelengths,
+    /// MIS heuristic.
+    pub heuristic: MisHeuristic,
+}
+
+/// Evaluates strategy (s, t); `None` when it contributes nothing.
+pub(crate) fn connect(
+    cx: &ConnectCtx<'_>,
+    light: &[Vertex],
+    cam: &[Vertex],
+    s: usize,
+    t: usize,
+    sampler: &mut Sampler,
+) -> Option<Contribution> {
+    if s == 0 {
+        return connect_emitter(cx, cam, t);
+    }
+    let (c, view) = strategy(cx, light, cam, s, t, sampler)?;
+    let w = mis_weight(cx.scene, cx.camera, &view, cx.heuristic);
+    Some(Contribution {
+        unweighted: c.0,
+        weighted: c.0 * w,
+        p_raster: c.1,
+    })
+}
+
+/// Unweighted contribution and raster position (t = 1) of a strategy.
+pub(crate) type Unweighted = (SampledSpectrum, Option<Vec2>);
+
+/// The unweighted contribution of strategy (s ≥ 1, t) and the path it made.
+pub(crate) fn strategy<'a>(
+    cx: &ConnectCtx<'_>,
+    light: &'a [Vertex],
+    cam: &'a [Vertex],
+    s: usize,
+    t: usize,
+    sampler: &mut Sampler,
+) -> Option<(Unweighted, PathView<'a>)> {
+    debug_assert!(s >= 1 && t >= 1);
+    if cam[t - 1].at_infinity() {
+        return None;
+    }
+    if t == 1 {
+        connect_camera(cx, light, cam, s, sampler)
+    } else if s == 1 {
+        connect_light(cx, light, cam, t, sampler)
+    } else {
+        connect_inner(cx, light, cam, s, t)
+    }
+}
+
+/// s = 0: emission of the last camera vertex (every infinite light for an escaped ray).
+fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Contribution> {
+    let v = cam[t - 1];
+    let mut out = Contribution {
+        unweighted: SampledSpectrum::zero(),
+        weighted: SampledSpectrum::zero(),
+        p_raster: None,
+    };
+    let mut add = |e: Vertex| {
+        let le = emitted(cx.scene, &e, e.wo, cx.lambda);
+        if le.is_black() {
+            return;
+        }
+        let c = v.beta * le;
+        let view = PathView {
+            light: &[],
+            cam,
+            s: 0,
+            t,
+            light_end: None,
+            cam_end: Some(e),
+        };
+        out.unweighted += c;
+        out.weighted += c * mis_weight(cx.scene, cx.camera, &view, cx.heuristic);
+    };
+    if v.at_infinity() {
+        for &id in cx.scene.infinite_lights() {
+            let mut e = v;
+            e.kind = VertexKind::Light(id);
+            add(e);
+        }
+    } else if v.area_light.is_some() {
+        add(v);
+    }
+    (!out.unweighted.is_black()).then_some(out)
+}
+
+/// t = 1: connects light vertex s − 1 to a sampled lens point.
+fn connect_camera<'a>(
+    cx: &ConnectCtx<'_>,
+    light: &'a [Vertex],
+    cam: &'a [Vertex],
+    s: usize,
+    sampler: &mut Sampler,
+) -> Option<(Unweighted, PathView<'a>)> {
+    let v = &light[s - 1];
+    let u = sampler.get_2d();
+    if cx.camera.is_delta_direction() {
+        return None;
+    }
+    let f_hat = match v.kind {
+        VertexKind::Light(id) => {
+            if cx.scene.light(id).light_type() != LightType::Area {
+                return None;
+            }
+            let cs = cx.camera.sample_wi(&v.it, u)?;
+            let le = emitted(cx.scene, v, cs.wi, cx.lambda) * cs.wi.dot(v.it.n).abs();
+            (le, cs)
+        }
+        _ => {
+            let bsdf = v.bsdf.as_ref()?;
+            if !bsdf.flags().is_non_specular() {
+                return None;
+            }
+            let cs = cx.camera.sample_wi(&v.it, u)?;
+            (light_side_f(v, cs.wi), cs)
+        }
+    };
+    let (f, cs) = f_hat;
+    if cs.pdf.0 == 0.0 || f.is_black() {
+        return None;
+    }
+    let c = v.beta * f * (cs.we / cs.pdf.0);
+    if c.is_black() || !cx.scene.unoccluded(&v.it, &cs.p_lens) {
+        return None;
+    }
+    let mut lens = Vertex::camera(cs.p_lens, SampledSpectrum::splat(cs.we / cs.pdf.0));
+    lens.pdf_fwd = 0.0;
+    let view = PathView {
+        light,
+        cam,
+        s,
+        t: 1,
+        light_end: None,
+        cam_end: Some(lens),
+    };
+    Some(((c, Some(cs.p_raster)), view))
+}
+
+/// s = 1: next-event estimation from camera vertex t − 1.
+fn connect_light<'a>(
+    cx: &ConnectCtx<'_>,
+    light: &'a [Vertex],
+    cam: &'a [Vertex],
+    t: usize,
+    sampler: &mut Sampler,
+) -> Option<(Unweighted, PathView<'a>)> {
+    let v = &cam[t - 1];
+    let (u_light, u) = (sampler.get_1d(), sampler.get_2d());
+    let bsdf = v.bsdf.as_ref()?;
+    if !bsdf.flags().is_non_specular() {
+        return None;
+    }
+    let (id, p_light) = cx.scene.light_sampler().sample(u_light)?;
+    let l = cx.scene.light(id);
+    let ctx = LightSampleContext {
+        p: v.it.p,
+        p_error: v.it.p_error,
+        n: v.it.n,
+        ns: v.ns,
+    };
+    let ls = l.sample_li(&ctx, u, cx.lambda)?;
+    if ls.l.is_black() || ls.pdf.0 == 0.0 {
+        return None;
+    }
+    let f = bsdf.f(v.wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(v.ns).abs();
+    let c = v.beta * f * ls.l / (p_light * ls.pdf.0);
+    if c.is_black() || !cx.scene.unoccluded(&v.it, &ls.p_light) {
+        return None;
+    }
+    let at_inf = matches!(
+        l.light_type(),
+        LightType::Infinite | LightType::DeltaDirection
+    );
+    let w_inf = if at_inf { -ls.wi } else { Vec3::ZERO };
+    let it = if ls.p_light.is_surface() || at_inf {
+        ls.p_light
+    } else {
+        Interaction::at_point(ls.p_light.p)
+    };
+    let mut e = Vertex::light(id, it, w_inf, SampledSpectrum::zero());
+    e.pdf_fwd = pdf_light_origin(cx.scene, &e, v);
+    let view = PathView {
+        light,
+        cam,
+        s: 1,
+        t,
+        light_end: Some(e),
+        cam_end: None,
+    };
+    Some(((c, None), view))
+}
+
+/// s, t ≥ 2: joins two surface vertices with a shadow ray.
+fn connect_inner<'a>(
+    cx: &ConnectCtx<'_>,
+    light: &'a [Vertex],
+    cam: &'a [Vertex],
+    s: usize,
+    t: usize,
+) -> Option<(Unweighted, PathView<'a>)> {
+    let (lv, cv) = (&light[s - 1], &cam[t - 1]);
+    let (lb, cb) = (lv.bsdf.as_ref()?, cv.bsdf.as_ref()?);
+    if !lb.flags().is_non_specular() || !cb.flags().is_non_specular() {
+        return None;
+    }
+    let d = cv.p() - lv.p();
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    let w = d / d2.sqrt();
+    let f_cam = cb.f(cv.wo, -w, TransportMode::Radiance) * w.dot(cv.ns).abs();
+    let c = lv.beta * light_side_f(lv, w) * f_cam * cv.beta / d2;
+    if c.is_black() || !cx.scene.unoccluded(&lv.it, &cv.it) {
+        return None;
+    }
+    let view = PathView {
+        light,
+        cam,
+        s,
+        t,
+        light_end: None,
+        cam_end: None,
+    };
+    Some(((c, None), view))
+}
+
+/// f̂ = f·|ωo·ns||ωi·ng|/|ωo·ng| at a light-subpath surface vertex scattering towards `wi`.
+fn light_side_f(v: &Vertex, wi: Vec3) -> SampledSpectrum {
+    let Some(bsdf) = &v.bsdf else {
+        return SampledSpectrum::zero();
+    };
+    let den = v.wo.dot(v.it.n).abs();
+    if den == 0.0 {
+        return SampledSpectrum::zero();
+    }
+    bsdf.f(v.wo, wi, TransportMode::Importance)
+        * (v.wo.dot(v.ns).abs() * wi.dot(v.it.n).abs() / den)
+}

@@ -1,0 +1,214 @@
+//! Multiple importance sampling weights of BDPT strategies by recursive
+//! density ratios [Veach 1997, §10.2.1, eqs. 10.9–10.11].
+//!
+//! A path x₀…x_{n−1} (x₀ on a light, x_{n−1} on the camera) can be made by
+//! the strategies k = 0…n−1 that take k vertices from a light subpath and
+//! n − k from a camera subpath. With p_L[i] the area density of x_i generated
+//! from the light side and p_E[i] from the camera side, strategy k has
+//! density p_k = Π_{i<k} p_L[i] · Π_{i≥k} p_E[i], so p_{k+1}/p_k = p_L[k]/p_E[k].
+//! Walking these ratios outward from the strategy used gives every p_k/p_s
+//! without products that under- or overflow. A strategy counts only if it
+//! can sample the path: its connection must not touch a specular vertex,
+//! k = 0 needs a hittable emitter at x₀, and t = 1 a camera that can be
+//! connected to. Zero densities (specular vertices) are mapped to 1 so the
+//! ratios pass through them, as in pbrt.
+//!
+//! The densities next to the connection are unknown to either subpath and
+//! are computed here; all others were stored by the random walks.
+
+use super::vertex::{pdf, pdf_light_origin, Vertex};
+use crate::bsdf::TransportMode;
+use crate::camera::Camera;
+use crate::light::LightType;
+use crate::scene::Scene;
+
+/// The weighting function applied to the strategy densities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MisHeuristic {
+    /// w_s = p_s / Σ p_k [Veach 1997, eq. 9.10].
+    Balance,
+    /// w_s = p_s² / Σ p_k² [Veach 1997, eq. 9.13].
+    Power,
+}
+
+impl MisHeuristic {
+    #[inline]
+    fn apply(self, r: f32) -> f32 {
+        match self {
+            MisHeuristic::Balance => r,
+            MisHeuristic::Power => r * r,
+        }
+    }
+}
+
+/// The full path of strategy (s, t), indexed from the light: vertex i is
+/// `light[i]` for i < s and `cam[n − 1 − i]` otherwise, with optional
+/// replacements for the two connection endpoints (sampled light or lens points).
+pub(crate) struct PathView<'a> {
+    /// Light subpath (at least `s` vertices).
+    pub light: &'a [Vertex],
+    /// Camera subpath (at least `t` vertices).
+    pub cam: &'a [Vertex],
+    /// Vertices taken from the light subpath.
+    pub s: usize,
+    /// Vertices taken from the camera subpath.
+    pub t: usize,
+    /// Replaces `light[s − 1]`.
+    pub light_end: Option<Vertex>,
+    /// Replaces `cam[t − 1]`.
+    pub cam_end: Option<Vertex>,
+}
+
+impl PathView<'_> {
+    /// Number of vertices.
+    #[inline]
+    pub fn n(&self) -> usize {
+        self.s + self.t
+    }
+
+    /// Vertex i counted from the light end.
+    pub fn get(&self, i: usize) -> &Vertex {
+        if i < self.s {
+            match &self.light_end {
+                Some(v) if i == self.s - 1 => v,
+                _ => &self.light[i],
+            }
+        } else {
+            let j = self.n() - 1 - i;
+            match &self.cam_end {
+                Some(v) if j == self.t - 1 => v,
+                _ => &self.cam[j],
+            }
+        }
+    }
+}
+
+/// p_L and p_E of one path: stored densities plus the ones the connection creates.
+pub(crate) struct PathDensities {
+    /// p_L[i].
+    pub p_light: Vec<f32>,
+    /// p_E[i].
+    pub p_eye: Vec<f32>,
+    /// Whether x_i is specular (the connection endpoints never are).
+    pub delta: Vec<bool>,
+}
+
+impl PathDensities {
+    /// Gathers the densities of `view`, computing the four (at s = 0: three
+    /// plus the emitter's origin density) that depend on the connection.
+    pub fn of(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
+        let (n, s) = (view.n(), view.s);
+        let mut p_light = Vec::with_capacity(n);
+        let mut p_eye = Vec::with_capacity(n);
+        let mut delta = Vec::with_capacity(n);
+        for i in 0..n {
+            let v = view.get(i);
+            if i < s {
+                p_light.push(v.pdf_fwd);
+                p_eye.push(v.pdf_rev);
+            } else {
+                p_light.push(v.pdf_rev);
+                p_eye.push(v.pdf_fwd);
+            }
+            delta.push(v.delta && i + 1 != s && i != s);
+        }
+        let (imp, rad) = (TransportMode::Importance, TransportMode::Radiance);
+        let x = |i: usize| view.get(i);
+        if s == 0 {
+            p_light[0] = pdf_light_origin(scene, x(0), x(1));
+        } else {
+            let prev = (s >= 2).then(|| x(s - 2));
+            p_light[s] = pdf(scene, camera, x(s - 1), prev, x(s), imp);
+            let prev = (view.t >= 2).then(|| x(s + 1));
+            p_eye[s - 1] = pdf(scene, camera, x(s), prev, x(s - 1), rad);
+        }
+        if s + 1 < n {
+            let prev = (s >= 1).then(|| x(s - 1));
+            p_light[s + 1] = pdf(scene, camera, x(s), prev, x(s + 1), imp);
+        }
+        if s >= 2 {
+            p_eye[s - 2] = pdf(scene, camera, x(s - 1), Some(x(s)), x(s - 2), rad);
+        }
+        Self {
+            p_light,
+            p_eye,
+            delta,
+        }
+    }
+}
+
+/// Whether strategy k (k light vertices, n − k camera vertices) can make the path.
+pub(crate) fn strategy_valid(
+    scene: &Scene,
+    camera: &Camera,
+    x0: &Vertex,
+    delta: &[bool],
+    k: usize,
+) -> bool {
+    let n = delta.len();
+    if k >= n {
+        return false; // t = 0: candela never hits the lens.
+    }
+    if k == 0 {
+        return x0.is_hittable_light(scene);
+    }
+    if delta[k - 1] || delta[k] {
+        return false;
+    }
+    if k == n - 1 {
+        if camera.is_delta_direction() {
+            return false;
+        }
+        if k == 1 {
+            // s = 1, t = 1: only an area light can be seen directly.
+            let area = x0
+                .light_id()
+                .is_some_and(|id| scene.light(id).light_type() == LightType::Area);
+            return area;
+        }
+    }
+    true
+}
+
+/// MIS weight of strategy `s` for the path with densities `d`.
+pub(crate) fn weight_from_densities(
+    scene: &Scene,
+    camera: &Camera,
+    x0: &Vertex,
+    d: &PathDensities,
+    s: usize,
+    h: MisHeuristic,
+) -> f32 {
+    let n = d.delta.len();
+    let remap0 = |p: f32| if p != 0.0 { p } else { 1.0 };
+    let mut sum = 1.0f32;
+    let mut r = 1.0f32;
+    for k in s + 1..n {
+        r *= remap0(d.p_light[k - 1]) / remap0(d.p_eye[k - 1]);
+        if strategy_valid(scene, camera, x0, &d.delta, k) {
+            sum += h.apply(r);
+        }
+    }
+    r = 1.0;
+    for k in (0..s).rev() {
+        r *= remap0(d.p_eye[k]) / remap0(d.p_light[k]);
+        if strategy_valid(scene, camera, x0, &d.delta, k) {
+            sum += h.apply(r);
+        }
+    }
+    if !sum.is_finite() {
+        return 0.0;
+    }
+    1.0 / sum
+}
+
+/// MIS weight of the strategy that made `view`.
+pub(crate) fn mis_weight(
+    scene: &Scene,
+    camera: &Camera,
+    view: &PathView<'_>,
+    h: MisHeuristic,
+) -> f32 {
+    let d = PathDensities::of(scene, camera, view);
+    weight_from_densities(scene, camera, view.get(0), &d, view.s, h)
+}

@@ -1,0 +1,124 @@
+//! Bidirectional path tracing (`Integrator "bdpt"`) [Veach & Guibas 1995;
+//! Veach 1997, ch. 10; pbrt-v3/v4 `BDPTIntegrator`].
+//!
+//! For each pixel sample the estimator
+//! 1. traces a camera subpath from the primary ray (radiance mode, β starts at 1: a primary
+//!    camera ray has weight 1, seed §2.4),
+//! 2. traces a light subpath from a light chosen in proportion to its power
+//!    (importance mode, β₀ = Le|cos θ|/(p_light·p_pos·p_dir), the path's
+//!    share of Φ, seed §2.1),
+//! 3. evaluates every strategy (s, t) with s + t − 2 ≤ `maxdepth`
+//!    scattering events: s = 0 (the camera path hits an emitter), s = 1
+//!    (next-event estimation), t = 1 (light tracing, splatted) and the
+//!    general connections, each weighted by MIS over every strategy that
+//!    could have made the same path ([`mis`]).
+//!
+//! The pieces are free functions: [`walk::generate_camera_subpath`],
+//! [`walk::generate_light_subpath`], [`connect::connect`] and
+//! [`mis::mis_weight`]. Splats (t = 1) go through the driver's
+//! deterministic splat lanes and are scaled by 1/spp.
+
+mod connect;
+mod mis;
+#[cfg(test)]
+mod tests;
+mod vertex;
+mod walk;
+
+pub use mis::MisHeuristic;
+
+use super::{driver, Integrator, PixelEstimator, RenderContext};
+use crate::film::{RgbFilm, SplatBuffer};
+use crate::math::Ray;
+use crate::sampler::Sampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use connect::{connect, ConnectCtx};
+use walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
+
+/// Parameters of `Integrator "bdpt"`.
+#[derive(Clone, Debug)]
+pub struct BdptSettings {
+    /// Maximum number of scattering events of a path (pbrt-v4 default 5).
+    pub max_depth: u32,
+    /// Roughen near-specular lobes after the first non-specular bounce (biased).
+    pub regularize: bool,
+    /// MIS heuristic (power by default).
+    pub heuristic: MisHeuristic,
+}
+
+impl Default for BdptSettings {
+    fn default() -> Self {
+        Self {
+            max_depth: 5,
+            regularize: false,
+            heuristic: MisHeuristic::Power,
+        }
+    }
+}
+
+/// The bidirectional path tracer.
+pub struct BdptIntegrator {
+    /// Settings.
+    pub settings: BdptSettings,
+}
+
+impl Integrator for BdptIntegrator {
+    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
+        driver::render_pixels(self, ctx, film);
+    }
+}
+
+impl PixelEstimator for BdptIntegrator {
+    fn li(
+        &self,
+        ctx: &RenderContext<'_>,
+        ray: Ray,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        splats: &mut SplatBuffer,
+    ) -> SampledSpectrum {
+        let max_depth = self.settings.max_depth as usize;
+        let (mut cam, mut light) = (Vec::new(), Vec::new());
+        let walk = |max_vertices| WalkSettings {
+            max_vertices,
+            regularize: self.settings.regularize,
+        };
+        generate_camera_subpath(
+            ctx.scene,
+            ctx.camera,
+            ray,
+            lambda,
+            sampler,
+            walk(max_depth + 1),
+            &mut cam,
+        );
+        generate_light_subpath(ctx.scene, lambda, sampler, walk(max_depth), &mut light);
+        let lambda = *lambda;
+        let cx = ConnectCtx {
+            scene: ctx.scene,
+            camera: ctx.camera,
+            lambda: &lambda,
+            heuristic: self.settings.heuristic,
+        };
+        let mut l = SampledSpectrum::zero();
+        for t in 1..=cam.len() {
+            for s in 0..=light.len() {
+                if s + t < 2 || s + t - 2 > max_depth || (s == 0 && t == 1) {
+                    continue;
+                }
+                let Some(c) = connect(&cx, &light, &cam, s, t, sampler) else {
+                    continue;
+                };
+                match c.p_raster {
+                    Some(p) => splats.add(p, c.weighted, &lambda),
+                    None => l += c.weighted,
+                }
+            }
+        }
+        l
+    }
+
+    fn splats(&self) -> bool {
+        true
+    }
+}
