@@ -252,3 +252,45 @@ fn bdpt_is_bit_identical_across_thread_counts() {
     };
     assert_eq!(run(1), run(2));
 }
+
+#[test]
+fn t7_each_bdpt_strategy_alone_renders_the_emitter_radiance() {
+    // visualizestrategies writes each strategy's unweighted estimate: the
+    // camera hitting the emitter (s = 0, t = 2) and the light point splatted
+    // to the lens (s = 1, t = 1) are two complete estimators of L = 2.
+    // visualizeweights writes weighted estimates, which sum to the image.
+    let dir = std::env::temp_dir().join(format!("candela-vis-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    for (flag, weighted) in [("visualizestrategies", false), ("visualizeweights", true)] {
+        let scene = emitter_scene("bdpt").replace(
+            "Integrator \"bdpt\" \"integer maxdepth\" [5]",
+            &format!("Integrator \"bdpt\" \"integer maxdepth\" [1] \"bool {flag}\" true"),
+        );
+        assert!(scene.contains(flag));
+        let ov = Overrides {
+            outfile: Some(dir.join("main.exr")),
+            ..bdpt(512)
+        };
+        let main = render_str(&scene, &ov);
+        let read = |name: &str| {
+            candela_core::image::RgbImage::read_exr(&dir.join(name)).expect("strategy image")
+        };
+        let (a, b) = (read("bdpt_d00_s00_t02.exr"), read("bdpt_d00_s01_t01.exr"));
+        if weighted {
+            // Interior pixels (splats near the border leak outside the film).
+            for y in 1..15 {
+                for x in 1..23 {
+                    for c in 0..3 {
+                        let sum = a.get(x, y)[c] + b.get(x, y)[c];
+                        let m = main.get(x, y)[c];
+                        assert!((sum - m).abs() <= 1e-4 * m, "({x},{y}) {sum} vs {m}");
+                    }
+                }
+            }
+        } else {
+            assert_region(&a, (1, 23, 1, 15), 2.0, 2e-3 * 2.0, "T7 s=0 t=2 alone");
+            assert_region(&b, (1, 23, 1, 15), 2.0, 2e-3 * 2.0, "T7 s=1 t=1 alone");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

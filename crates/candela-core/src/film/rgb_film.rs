@@ -147,6 +147,16 @@ impl RgbFilm {
         }
     }
 
+    /// A film with the same settings and no samples.
+    pub fn cleared(&self) -> Self {
+        Self::new(
+            self.settings.clone(),
+            self.filter.clone(),
+            self.sensor.clone(),
+            self.output_from_sensor,
+        )
+    }
+
     /// Full resolution.
     pub fn resolution(&self) -> UVec2 {
         self.settings.resolution

@@ -64,7 +64,7 @@ pub fn render_pixels(est: &dyn PixelEstimator, ctx: &RenderContext<'_>, film: &m
 }
 
 /// The 16×16 tiles covering the pixel bounds, in scanline order.
-fn tiles(bounds: (UVec2, UVec2)) -> Vec<(UVec2, UVec2)> {
+pub(crate) fn tiles(bounds: (UVec2, UVec2)) -> Vec<(UVec2, UVec2)> {
     let (w, h) = (bounds.1.x - bounds.0.x, bounds.1.y - bounds.0.y);
     (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
@@ -106,14 +106,42 @@ fn render_sample(
     sampler: &mut Sampler,
     splats: &mut SplatBuffer,
 ) {
-    // Sample order follows pbrt-v4's GetCameraSample: wavelengths, filter, lens.
-    let mut lambda = SampledWavelengths::sample_visible(sampler.get_1d());
+    let Some(mut cs) = camera_sample(ctx, film, pixel, sampler) else {
+        return;
+    };
+    let l = est.li(ctx, cs.ray, &mut cs.lambda, sampler, splats) * cs.ray_weight;
+    tile.add_sample(pixel, l, &cs.lambda, cs.filter_weight);
+}
+
+/// The primary ray of one pixel sample and what the film needs to record it.
+pub(crate) struct PixelSample {
+    /// The camera ray.
+    pub ray: crate::math::Ray,
+    /// Its weight (1 for candela's cameras).
+    pub ray_weight: f32,
+    /// Sampled wavelengths.
+    pub lambda: SampledWavelengths,
+    /// Filter-sample weight.
+    pub filter_weight: f32,
+}
+
+/// Draws wavelengths, a filter offset and a lens point for `pixel`, in
+/// pbrt-v4's `GetCameraSample` order, and generates the camera ray.
+pub(crate) fn camera_sample(
+    ctx: &RenderContext<'_>,
+    film: &RgbFilm,
+    pixel: UVec2,
+    sampler: &mut Sampler,
+) -> Option<PixelSample> {
+    let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
     let fs = film.filter().sample(sampler.get_pixel_2d());
     let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
     let p_lens = sampler.get_2d();
-    let Some(cr) = ctx.camera.generate_ray(CameraSample { p_film, p_lens }) else {
-        return;
-    };
-    let l = est.li(ctx, cr.ray, &mut lambda, sampler, splats) * cr.weight;
-    tile.add_sample(pixel, l, &lambda, fs.weight);
+    let cr = ctx.camera.generate_ray(CameraSample { p_film, p_lens })?;
+    Some(PixelSample {
+        ray: cr.ray,
+        ray_weight: cr.weight,
+        lambda,
+        filter_weight: fs.weight,
+    })
 }

@@ -10,7 +10,7 @@ pub mod driver;
 mod light_tracer;
 mod path;
 
-pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic};
+pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::LightTracer;
 pub use path::{PathIntegrator, PathSettings};
 

@@ -102,7 +102,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let camera = entities::camera(desc, &film)?;
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let (integrator, integrator_name, power_sampling) =
-        entities::integrator(desc, ov, &mut warnings)?;
+        entities::integrator(desc, ov, &outfile, &mut warnings)?;
     let materials = geometry::materials(desc)?;
     let (primitives, mut lights) = geometry::primitives(desc, &materials.1)?;
     lights.extend(lights::lights(desc)?);

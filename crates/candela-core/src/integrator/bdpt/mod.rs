@@ -23,16 +23,18 @@ mod mis;
 #[cfg(test)]
 mod tests;
 mod vertex;
+mod visualize;
 mod walk;
 
 pub use mis::MisHeuristic;
+pub use visualize::Visualize;
 
 use super::{driver, Integrator, PixelEstimator, RenderContext};
 use crate::film::{RgbFilm, SplatBuffer};
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use connect::{connect, ConnectCtx};
+use connect::{connect, ConnectCtx, Contribution};
 use walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
 
 /// Parameters of `Integrator "bdpt"`.
@@ -44,6 +46,8 @@ pub struct BdptSettings {
     pub regularize: bool,
     /// MIS heuristic (power by default).
     pub heuristic: MisHeuristic,
+    /// Write one image per strategy (pbrt-v4 `visualizestrategies` / `visualizeweights`).
+    pub visualize: Option<Visualize>,
 }
 
 impl Default for BdptSettings {
@@ -52,6 +56,7 @@ impl Default for BdptSettings {
             max_depth: 5,
             regularize: false,
             heuristic: MisHeuristic::Power,
+            visualize: None,
         }
     }
 }
@@ -64,7 +69,10 @@ pub struct BdptIntegrator {
 
 impl Integrator for BdptIntegrator {
     fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-        driver::render_pixels(self, ctx, film);
+        match &self.settings.visualize {
+            Some(v) => visualize::render(self, v, ctx, film),
+            None => driver::render_pixels(self, ctx, film),
+        }
     }
 }
 
@@ -77,6 +85,32 @@ impl PixelEstimator for BdptIntegrator {
         sampler: &mut Sampler,
         splats: &mut SplatBuffer,
     ) -> SampledSpectrum {
+        let mut l = SampledSpectrum::zero();
+        self.sample_strategies(ctx, ray, lambda, sampler, |_, _, c, lambda| {
+            match c.p_raster {
+                Some(p) => splats.add(p, c.weighted, lambda),
+                None => l += c.weighted,
+            }
+        });
+        l
+    }
+
+    fn splats(&self) -> bool {
+        true
+    }
+}
+
+impl BdptIntegrator {
+    /// Traces both subpaths for one camera ray and calls `visit(s, t, c, λ)`
+    /// for every strategy that contributes.
+    fn sample_strategies(
+        &self,
+        ctx: &RenderContext<'_>,
+        ray: Ray,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        mut visit: impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
+    ) {
         let max_depth = self.settings.max_depth as usize;
         let (mut cam, mut light) = (Vec::new(), Vec::new());
         let walk = |max_vertices| WalkSettings {
@@ -100,25 +134,15 @@ impl PixelEstimator for BdptIntegrator {
             lambda: &lambda,
             heuristic: self.settings.heuristic,
         };
-        let mut l = SampledSpectrum::zero();
         for t in 1..=cam.len() {
             for s in 0..=light.len() {
                 if s + t < 2 || s + t - 2 > max_depth || (s == 0 && t == 1) {
                     continue;
                 }
-                let Some(c) = connect(&cx, &light, &cam, s, t, sampler) else {
-                    continue;
-                };
-                match c.p_raster {
-                    Some(p) => splats.add(p, c.weighted, &lambda),
-                    None => l += c.weighted,
+                if let Some(c) = connect(&cx, &light, &cam, s, t, sampler) {
+                    visit(s, t, &c, &lambda);
                 }
             }
         }
-        l
-    }
-
-    fn splats(&self) -> bool {
-        true
     }
 }

@@ -5,7 +5,7 @@ use crate::camera::{Camera, CameraParams};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{FilmSettings, RgbFilm};
 use crate::integrator::{
-    BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings,
+    BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings, Visualize,
 };
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
@@ -243,6 +243,7 @@ pub fn sampler(
 pub fn integrator(
     desc: &SceneDescription,
     ov: &Overrides,
+    outfile: &std::path::Path,
     warnings: &mut Vec<String>,
 ) -> Result<(Box<dyn Integrator>, String, bool), BuildError> {
     let empty = super::default_entity("volpath");
@@ -271,17 +272,19 @@ pub fn integrator(
             return Ok((Box::new(LightTracer { max_depth, seed }), name, power));
         }
         "bdpt" => {
-            for flag in ["visualizestrategies", "visualizeweights"] {
-                if p.get_bool(flag, false)? {
-                    return Err(BuildError::at(
-                        p.param_loc(flag).unwrap_or(&e.loc),
-                        format!("bdpt \"{flag}\" is not supported yet"),
-                    ));
-                }
-            }
+            let strategies = p.get_bool("visualizestrategies", false)?;
+            let weights = p.get_bool("visualizeweights", false)?;
+            let visualize = (strategies || weights).then(|| Visualize {
+                weighted: weights,
+                dir: outfile
+                    .parent()
+                    .map(|d| d.to_path_buf())
+                    .unwrap_or_default(),
+            });
             let settings = BdptSettings {
                 max_depth,
                 regularize,
+                visualize,
                 ..BdptSettings::default()
             };
             return Ok((Box::new(BdptIntegrator { settings }), name, power));
