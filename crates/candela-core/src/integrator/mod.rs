@@ -9,6 +9,7 @@ mod bdpt;
 pub mod driver;
 mod light_tracer;
 mod path;
+pub mod photon;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::LightTracer;
