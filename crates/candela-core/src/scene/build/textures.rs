@@ -443,3 +443,63 @@ fn noise_sum(d: &TextureDesc) -> Result<NoiseSum, BuildError> {
         omega: p.get_float("roughness", 0.5)?,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec2;
+    use crate::texture::{inside_polka_dot, TextureEvalContext};
+    use std::path::Path;
+
+    fn descs(world: &str) -> Vec<TextureDesc> {
+        let text = format!("WorldBegin\n{world}\n");
+        candela_scene::parse_str(&text, Path::new("t.pbrt"))
+            .expect("parses")
+            .textures
+    }
+
+    fn at_uv(u: f32, v: f32) -> TextureEvalContext {
+        TextureEvalContext {
+            uv: Vec2::new(u, v),
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn dots_swap_inside_and_outside_like_pbrt() {
+        let d = descs(r#"Texture "d" "float" "dots" "float inside" [5] "float outside" [7]"#);
+        let t = Textures::new(&d).build_float(0).expect("builds");
+        // Find a cell with a dot; its centre is inside, its corner outside.
+        let cell = (0..100)
+            .map(|i| Vec2::new(i as f32, 0.0))
+            .find(|&c| inside_polka_dot(c))
+            .expect("some cell has a dot");
+        assert_eq!(t.evaluate(&at_uv(cell.x, cell.y)), 7.0);
+        assert_eq!(t.evaluate(&at_uv(cell.x + 0.49, cell.y + 0.49)), 5.0);
+    }
+
+    #[test]
+    fn mapping_parameters_and_texture_space_are_read() {
+        let d = descs(
+            r#"Texture "c" "float" "checkerboard" "float uscale" [4] "float udelta" [0.5]
+AttributeBegin
+Rotate 90 1 0 0
+Texture "m" "float" "directionmix" "float tex1" [1] "float tex2" [0] "vector3 dir" [0 1 0]
+AttributeEnd"#,
+        );
+        let mut tex = Textures::new(&d);
+        let c = tex.build_float(0).expect("builds");
+        // s = 4u + 0.5: u = 0.1 → 0.9 (even cell), u = 0.2 → 1.3 (odd).
+        assert_eq!(c.evaluate(&at_uv(0.1, 0.5)), 1.0);
+        assert_eq!(c.evaluate(&at_uv(0.2, 0.5)), 0.0);
+        // dir = +y in texture space is ±z in render space after the rotation.
+        let m = tex.build_float(1).expect("builds");
+        let ctx = |n: Vec3| TextureEvalContext {
+            n,
+            ..Default::default()
+        };
+        assert!((m.evaluate(&ctx(Vec3::Z)) - 1.0).abs() < 1e-6);
+        assert!(m.evaluate(&ctx(Vec3::Y)).abs() < 1e-6);
+        assert_eq!(tex.used(), &[true, true]);
+    }
+}
