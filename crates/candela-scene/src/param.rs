@@ -305,6 +305,18 @@ impl ParamSet {
         }
     }
 
+    /// All values of a string parameter, if present.
+    pub fn get_strings(&self, name: &str) -> Result<Option<Vec<String>>, SceneError> {
+        match self.lookup(name, &[ParamType::String], "strings")? {
+            None => Ok(None),
+            Some(Param {
+                value: ParamValue::Strings(v),
+                ..
+            }) => Ok(Some(v.clone())),
+            Some(p) => Err(kind_error(p, "strings")),
+        }
+    }
+
     /// A single point3, or `default` when absent.
     pub fn get_point3(&self, name: &str, default: [f32; 3]) -> Result<[f32; 3], SceneError> {
         Ok(self

@@ -118,7 +118,7 @@ impl LightTracer {
         let mut depth = 0;
         let mut lambda = lambda;
         while !beta.is_black() {
-            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+            let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
                 break;
             };
             // A connection here closes a path with `depth` scattering events, as
@@ -127,7 +127,7 @@ impl LightTracer {
             if depth > self.max_depth {
                 break;
             }
-            let Some(bsdf) = scene.bsdf(&si, &mut lambda) else {
+            let Some(bsdf) = scene.bsdf(&mut si, &mut lambda) else {
                 ray = si.spawn_ray(ray.d);
                 depth -= 1;
                 continue;

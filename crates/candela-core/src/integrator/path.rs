@@ -86,12 +86,12 @@ impl PixelEstimator for PathIntegrator {
             eta_scale: 1.0,
         };
         loop {
-            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+            let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
                 self.add_infinite_light(scene, &ray, lambda, &mut st);
                 break;
             };
             self.add_surface_emission(scene, &si, lambda, &mut st);
-            let Some(mut bsdf) = scene.bsdf(&si, lambda) else {
+            let Some(mut bsdf) = scene.bsdf(&mut si, lambda) else {
                 // Interface material: continue straight through, not a scattering event.
                 st.specular_bounce = true;
                 ray = si.spawn_ray(ray.d);

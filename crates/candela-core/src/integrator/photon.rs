@@ -97,12 +97,12 @@ pub fn trace_photon(
     let mut caustic = true;
     let mut depth = 0;
     while !beta.is_black() {
-        let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+        let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
             fate.escaped = beta;
             break;
         };
         let was_terminated = lam.secondary_terminated();
-        let Some(bsdf) = scene.bsdf(&si, &mut lam) else {
+        let Some(bsdf) = scene.bsdf(&mut si, &mut lam) else {
             ray = si.spawn_ray(ray.d);
             continue;
         };

@@ -5,13 +5,23 @@
 //! indices of refraction make the path's secondary wavelengths meaningless
 //! after refraction, so the dielectric terminates them (keeping only the hero
 //! wavelength, [Wilkie et al. 2014]).
+//!
+//! The scene resolves a [`Material::Mix`] to one of its materials per hit
+//! ([`mix_choice`]) and applies a material's `displacement` ([`apply_bump`])
+//! before asking it for a BSDF, as pbrt-v4's `SurfaceInteraction::GetBSDF`.
+
+mod bump;
+mod mix;
+
+pub use bump::{apply_bump, bump_map};
+pub use mix::mix_choice;
 
 use crate::bsdf::{
     Bsdf, Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, ThinDielectricBxdf, TrowbridgeReitz,
 };
-use crate::interaction::SurfaceInteraction;
+use crate::interaction::{MaterialId, SurfaceInteraction};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
-use crate::texture::{FloatTexture, SpectrumTexture};
+use crate::texture::{FloatTexture, SpectrumTexture, TextureEvalContext};
 
 /// Microfacet roughness parameters shared by conductors and dielectrics.
 #[derive(Clone, Debug)]
@@ -25,8 +35,8 @@ pub struct Roughness {
 }
 
 impl Roughness {
-    fn distribution(&self, si: &SurfaceInteraction) -> TrowbridgeReitz {
-        let (mut u, mut v) = (self.u.evaluate(si), self.v.evaluate(si));
+    fn distribution(&self, ctx: &TextureEvalContext) -> TrowbridgeReitz {
+        let (mut u, mut v) = (self.u.evaluate(ctx), self.v.evaluate(ctx));
         if self.remap {
             u = TrowbridgeReitz::roughness_to_alpha(u);
             v = TrowbridgeReitz::roughness_to_alpha(v);
@@ -56,6 +66,8 @@ pub enum Material {
     Diffuse {
         /// Albedo.
         reflectance: SpectrumTexture,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
     },
     /// Metal.
     Conductor {
@@ -63,6 +75,8 @@ pub enum Material {
         spec: ConductorSpec,
         /// Microfacet roughness.
         roughness: Roughness,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
     },
     /// Glass-like boundary.
     Dielectric {
@@ -70,50 +84,80 @@ pub enum Material {
         eta: Spectrum,
         /// Microfacet roughness.
         roughness: Roughness,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
     },
     /// Thin dielectric sheet.
     ThinDielectric {
         /// Index of refraction.
         eta: Spectrum,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
     },
     /// Marks a boundary without scattering (media transitions).
     Interface,
+    /// One of two materials per hit, the second with probability `amount`.
+    Mix {
+        /// The two materials.
+        materials: [MaterialId; 2],
+        /// Probability of the second.
+        amount: FloatTexture,
+    },
 }
 
 impl Material {
-    /// The BSDF at a hit, or `None` for [`Material::Interface`].
+    /// The BSDF at a hit, or `None` for [`Material::Interface`]. A
+    /// [`Material::Mix`] must have been resolved by the caller (it gives `None`).
     pub fn bsdf(&self, si: &SurfaceInteraction, lambda: &mut SampledWavelengths) -> Option<Bsdf> {
+        let ctx = TextureEvalContext::from_si(si);
         let bxdf = match self {
-            Material::Diffuse { reflectance } => Bxdf::Diffuse(DiffuseBxdf::new(
-                reflectance.evaluate(si, lambda).clamp(0.0, 1.0),
+            Material::Diffuse { reflectance, .. } => Bxdf::Diffuse(DiffuseBxdf::new(
+                reflectance.evaluate(&ctx, lambda).clamp(0.0, 1.0),
             )),
-            Material::Conductor { spec, roughness } => {
-                let (eta, k) = conductor_constants(spec, si, lambda);
-                Bxdf::Conductor(ConductorBxdf::new(roughness.distribution(si), eta, k))
+            Material::Conductor {
+                spec, roughness, ..
+            } => {
+                let (eta, k) = conductor_constants(spec, &ctx, lambda);
+                Bxdf::Conductor(ConductorBxdf::new(roughness.distribution(&ctx), eta, k))
             }
-            Material::Dielectric { eta, roughness } => Bxdf::Dielectric(DielectricBxdf::new(
+            Material::Dielectric { eta, roughness, .. } => Bxdf::Dielectric(DielectricBxdf::new(
                 hero_eta(eta, lambda),
-                roughness.distribution(si),
+                roughness.distribution(&ctx),
             )),
-            Material::ThinDielectric { eta } => {
+            Material::ThinDielectric { eta, .. } => {
                 Bxdf::ThinDielectric(ThinDielectricBxdf::new(hero_eta(eta, lambda)))
             }
             Material::Interface => return None,
+            Material::Mix { .. } => {
+                debug_assert!(false, "mix materials are resolved before bsdf()");
+                return None;
+            }
         };
         Some(Bsdf::new(si.shading.n, si.shading.dpdu, bxdf))
+    }
+
+    /// The bump map, if any.
+    pub fn displacement(&self) -> Option<&FloatTexture> {
+        match self {
+            Material::Diffuse { displacement, .. }
+            | Material::Conductor { displacement, .. }
+            | Material::Dielectric { displacement, .. }
+            | Material::ThinDielectric { displacement, .. } => displacement.as_ref(),
+            Material::Interface | Material::Mix { .. } => None,
+        }
     }
 }
 
 fn conductor_constants(
     spec: &ConductorSpec,
-    si: &SurfaceInteraction,
+    ctx: &TextureEvalContext,
     lambda: &SampledWavelengths,
 ) -> (SampledSpectrum, SampledSpectrum) {
     match spec {
-        ConductorSpec::EtaK { eta, k } => (eta.evaluate(si, lambda), k.evaluate(si, lambda)),
+        ConductorSpec::EtaK { eta, k } => (eta.evaluate(ctx, lambda), k.evaluate(ctx, lambda)),
         ConductorSpec::Reflectance(r) => {
             // η = 1, k = 2√r / √(1 − r) reproduces reflectance r at normal incidence [pbrt-v4 §10.5].
-            let r = r.evaluate(si, lambda).clamp(0.0, 0.9999);
+            let r = r.evaluate(ctx, lambda).clamp(0.0, 0.9999);
             (
                 SampledSpectrum::one(),
                 2.0 * r.sqrt() / (SampledSpectrum::one() - r).sqrt(),

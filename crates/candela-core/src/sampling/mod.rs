@@ -10,7 +10,7 @@ mod rng;
 mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
-pub use hash::{hash_u64s, mix_bits};
+pub use hash::{hash_u64s, mix_bits, murmur_hash64a};
 pub use pdf::{pdf_area_to_solid_angle, pdf_solid_angle_to_area, PdfArea, PdfSolidAngle};
 pub use rng::Pcg32;
 pub use warp::*;

@@ -8,7 +8,9 @@
 mod entities;
 mod geometry;
 mod lights;
+mod materials;
 mod spectra;
+mod textures;
 
 use crate::camera::Camera;
 use crate::film::RgbFilm;
@@ -103,11 +105,11 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let (integrator, integrator_name, power_sampling) =
         entities::integrator(desc, ov, &outfile, &mut warnings)?;
-    let materials = geometry::materials(desc)?;
-    let (primitives, mut lights) = geometry::primitives(desc, &materials.1)?;
+    let (materials, names, textures_used) = materials::materials(desc)?;
+    let (primitives, mut lights) = geometry::primitives(desc, &names)?;
     lights.extend(lights::lights(desc)?);
-    let scene = Scene::new(primitives, materials.0, lights, power_sampling);
-    collect_unused(desc, &mut warnings);
+    let scene = Scene::new(primitives, materials, lights, power_sampling);
+    collect_unused(desc, &textures_used, &mut warnings);
     Ok(RenderSetup {
         scene,
         camera,
@@ -127,8 +129,8 @@ fn unused_of(params: &ParamSet, what: &str, warnings: &mut Vec<String>) {
 }
 
 /// Reports every parameter that no builder looked at, and directives that
-/// are read but have no effect yet (`Option`, `Accelerator`, unreferenced textures).
-fn collect_unused(desc: &SceneDescription, warnings: &mut Vec<String>) {
+/// are read but have no effect (`Option`, `Accelerator`, textures no material uses).
+fn collect_unused(desc: &SceneDescription, textures_used: &[bool], warnings: &mut Vec<String>) {
     for (name, p) in &desc.options {
         warnings.push(format!(
             "{}: Option \"{name}\" is not supported yet and is ignored",
@@ -141,8 +143,15 @@ fn collect_unused(desc: &SceneDescription, warnings: &mut Vec<String>) {
             a.loc, a.name
         ));
     }
-    for t in &desc.textures {
-        warnings.push(format!("{}: texture \"{}\" (\"{}\") is not supported yet; it is not used by any supported material", t.loc, t.name, t.class));
+    for (t, &used) in desc.textures.iter().zip(textures_used) {
+        if used {
+            unused_of(&t.params, &format!("Texture \"{}\"", t.name), warnings);
+        } else {
+            warnings.push(format!(
+                "{}: texture \"{}\" is not used by any material; ignored",
+                t.loc, t.name
+            ));
+        }
     }
     for (e, what) in [
         (&desc.film, "Film"),

@@ -10,10 +10,11 @@ use crate::accel::Bvh;
 use crate::bsdf::Bsdf;
 use crate::interaction::{Interaction, LightId, SurfaceInteraction};
 use crate::light::{Light, LightSampler};
-use crate::material::Material;
+use crate::material::{apply_bump, mix_choice, Material};
 use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
 use crate::shape::WatertightRay;
 use crate::spectrum::SampledWavelengths;
+use crate::texture::TextureEvalContext;
 
 /// Everything rays can hit or be lit by.
 pub struct Scene {
@@ -124,9 +125,33 @@ impl Scene {
     }
 
     /// The BSDF at a hit (`None` for interface materials), with the
-    /// material's textures evaluated for `lambda`.
-    pub fn bsdf(&self, si: &SurfaceInteraction, lambda: &mut SampledWavelengths) -> Option<Bsdf> {
-        let m = &self.materials[si.material?.0 as usize];
+    /// material's textures evaluated for `lambda`. Mix materials are
+    /// resolved to one of their materials, and a bump map replaces the
+    /// hit's shading geometry (so the caller sees the bumped shading
+    /// normal), as in pbrt-v4's `SurfaceInteraction::GetBSDF`.
+    pub fn bsdf(
+        &self,
+        si: &mut SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+    ) -> Option<Bsdf> {
+        let m = self.resolve_material(si)?;
+        if let Some(d) = m.displacement() {
+            apply_bump(si, d);
+        }
         m.bsdf(si, lambda)
+    }
+
+    /// The hit's material with mixes resolved (the builder rejects cycles;
+    /// the bound guards against them anyway).
+    fn resolve_material(&self, si: &SurfaceInteraction) -> Option<&Material> {
+        let mut m = &self.materials[si.material?.0 as usize];
+        for _ in 0..self.materials.len() {
+            let Material::Mix { materials, amount } = m else {
+                return Some(m);
+            };
+            let a = amount.evaluate(&TextureEvalContext::from_si(si));
+            m = &self.materials[materials[mix_choice(a, si.p(), si.wo)].0 as usize];
+        }
+        None
     }
 }

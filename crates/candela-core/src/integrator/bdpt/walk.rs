@@ -142,13 +142,13 @@ fn random_walk(
     let mut eta_scale = 1.0f32;
     while !beta.is_black() && path.len() - start < settings.max_vertices {
         let prev = *path.last().expect("walk starts from an endpoint");
-        let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+        let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
             if mode == TransportMode::Radiance {
                 push_escape(scene, &ray, beta, pdf_dir, path);
             }
             break;
         };
-        let Some(mut bsdf) = scene.bsdf(&si, lambda) else {
+        let Some(mut bsdf) = scene.bsdf(&mut si, lambda) else {
             // An interface without scattering: not a vertex.
             ray = si.spawn_ray(ray.d);
             continue;

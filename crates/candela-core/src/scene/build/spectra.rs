@@ -6,7 +6,7 @@ use crate::spectrum::{named_spectrum, ColorSpace, Rgb, Spectrum};
 use candela_scene::{ParamSet, ParamSpectrum, SpectrumValue};
 
 /// How an RGB parameter is lifted to a spectrum [pbrt-v4 `SpectrumType`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SpectrumKind {
     /// Reflectances in [0, 1].
     Albedo,

@@ -1,0 +1,202 @@
+//! `Material` and `MakeNamedMaterial` directives → materials.
+//!
+//! Texture-valued parameters (reflectance, roughness, η, k, displacement,
+//! the mix amount) are resolved by [`Textures`]. A `mix` material names two
+//! named materials; its material ids are known before any material is
+//! built (anonymous materials first, then named ones in declaration
+//! order), and mixes that contain themselves are rejected.
+
+use super::spectra::{spectrum_param, SpectrumKind};
+use super::textures::{Source, Textures};
+use super::BuildError;
+use crate::interaction::MaterialId;
+use crate::material::{ConductorSpec, Material, Roughness};
+use crate::spectrum::{named_spectrum, Spectrum};
+use crate::texture::{FloatTexture, SpectrumTexture};
+use candela_scene::{MaterialDesc, SceneDescription};
+use std::collections::HashMap;
+
+/// Named material → id, and the default material's id.
+pub type MaterialNames = (HashMap<String, MaterialId>, MaterialId);
+
+/// All materials, the name table, and which `Texture` directives they used.
+pub fn materials(
+    desc: &SceneDescription,
+) -> Result<(Vec<Material>, MaterialNames, Vec<bool>), BuildError> {
+    let first_named = desc.materials.len();
+    let names: HashMap<String, MaterialId> = desc
+        .named_materials
+        .iter()
+        .enumerate()
+        .map(|(j, (name, _))| (name.clone(), MaterialId((first_named + j) as u32)))
+        .collect();
+    let all: Vec<&MaterialDesc> = desc
+        .materials
+        .iter()
+        .chain(desc.named_materials.iter().map(|(_, m)| m))
+        .collect();
+    let mut textures = Textures::new(&desc.textures);
+    let mut out = Vec::with_capacity(all.len() + 1);
+    for m in &all {
+        out.push(material(m, &mut textures, &names)?);
+    }
+    check_mix_cycles(&out, &all)?;
+    // pbrt-v4's default material: diffuse, reflectance 0.5.
+    let default = MaterialId(out.len() as u32);
+    out.push(Material::Diffuse {
+        reflectance: SpectrumTexture::Constant(Spectrum::Constant(0.5)),
+        displacement: None,
+    });
+    let used = textures.used().to_vec();
+    Ok((out, (names, default), used))
+}
+
+/// Roughness: `uroughness`/`vroughness`, each defaulting to `roughness` (0).
+fn roughness(src: &Source, tex: &mut Textures) -> Result<Roughness, BuildError> {
+    let u = tex.float_opt(src, "uroughness")?;
+    let v = tex.float_opt(src, "vroughness")?;
+    let common = match (&u, &v) {
+        (Some(_), Some(_)) => FloatTexture::Constant(0.0),
+        _ => tex.float(src, "roughness", 0.0)?,
+    };
+    Ok(Roughness {
+        u: u.unwrap_or_else(|| common.clone()),
+        v: v.unwrap_or(common),
+        remap: src.params.get_bool("remaproughness", true)?,
+    })
+}
+
+/// Index of refraction: a float or a spectrum (pbrt-v4 accepts both).
+fn eta(src: &Source) -> Result<Spectrum, BuildError> {
+    if let Some(v) = src.params.get_floats("eta")? {
+        return Ok(Spectrum::Constant(v.first().copied().unwrap_or(1.5)));
+    }
+    Ok(
+        spectrum_param(src.params, "eta", SpectrumKind::Unbounded, src.cs)?
+            .unwrap_or(Spectrum::Constant(1.5)),
+    )
+}
+
+/// A built-in spectrum as a constant texture.
+fn builtin(name: &str) -> Result<SpectrumTexture, BuildError> {
+    named_spectrum(name)
+        .map(SpectrumTexture::Constant)
+        .ok_or_else(|| BuildError::Other(format!("missing built-in spectrum {name}")))
+}
+
+/// A conductor's optical constants: `reflectance`, or `eta` and `k` (copper by default).
+fn conductor_spec(src: &Source, tex: &mut Textures) -> Result<ConductorSpec, BuildError> {
+    if let Some(r) = tex.spectrum_opt(src, "reflectance", SpectrumKind::Albedo)? {
+        return Ok(ConductorSpec::Reflectance(r));
+    }
+    let eta = match tex.spectrum_opt(src, "eta", SpectrumKind::Unbounded)? {
+        Some(e) => e,
+        None => builtin("metal-Cu-eta")?,
+    };
+    let k = match tex.spectrum_opt(src, "k", SpectrumKind::Unbounded)? {
+        Some(k) => k,
+        None => builtin("metal-Cu-k")?,
+    };
+    Ok(ConductorSpec::EtaK { eta, k })
+}
+
+fn material(
+    m: &MaterialDesc,
+    tex: &mut Textures,
+    names: &HashMap<String, MaterialId>,
+) -> Result<Material, BuildError> {
+    let src = Source::new(&m.params, &m.loc, &m.color_space)?;
+    if m.params.get_texture("normalmap").is_some()
+        || !m.params.get_string("normalmap", "")?.is_empty()
+    {
+        return Err(BuildError::at(&m.loc, "\"normalmap\" is not supported yet"));
+    }
+    let displacement = match m.ty.as_str() {
+        "mix" | "interface" | "" | "none" => None,
+        _ => tex.float_opt(&src, "displacement")?,
+    };
+    Ok(match m.ty.as_str() {
+        "diffuse" => Material::Diffuse {
+            reflectance: tex.spectrum(&src, "reflectance", SpectrumKind::Albedo, 0.5)?,
+            displacement,
+        },
+        "conductor" => Material::Conductor {
+            spec: conductor_spec(&src, tex)?,
+            roughness: roughness(&src, tex)?,
+            displacement,
+        },
+        "dielectric" => Material::Dielectric {
+            eta: eta(&src)?,
+            roughness: roughness(&src, tex)?,
+            displacement,
+        },
+        "thindielectric" => Material::ThinDielectric {
+            eta: eta(&src)?,
+            displacement,
+        },
+        "mix" => mix(&src, tex, names)?,
+        "interface" | "" | "none" => Material::Interface,
+        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, conductor, dielectric, thindielectric, mix, interface)"))),
+    })
+}
+
+/// `mix`: `"string materials" [a b]` (named materials) and `amount` (0.5).
+fn mix(
+    src: &Source,
+    tex: &mut Textures,
+    names: &HashMap<String, MaterialId>,
+) -> Result<Material, BuildError> {
+    let loc = src.params.param_loc("materials").unwrap_or(src.loc);
+    let list = src.params.get_strings("materials")?.unwrap_or_default();
+    let [a, b] = list.as_slice() else {
+        return Err(BuildError::at(
+            loc,
+            format!(
+                "mix material needs \"string materials\" with two named materials, found {}",
+                list.len()
+            ),
+        ));
+    };
+    let id = |n: &String| {
+        names.get(n).copied().ok_or_else(|| {
+            BuildError::at(
+                loc,
+                format!("mix material: named material \"{n}\" is not defined"),
+            )
+        })
+    };
+    Ok(Material::Mix {
+        materials: [id(a)?, id(b)?],
+        amount: tex.float(src, "amount", 0.5)?,
+    })
+}
+
+/// Rejects mix materials that reach themselves through their components.
+fn check_mix_cycles(materials: &[Material], descs: &[&MaterialDesc]) -> Result<(), BuildError> {
+    // 0 = unvisited, 1 = on the current path, 2 = done (depth-first search).
+    let mut state = vec![0u8; materials.len()];
+    fn visit(i: usize, m: &[Material], state: &mut [u8]) -> bool {
+        match state[i] {
+            1 => return false,
+            2 => return true,
+            _ => {}
+        }
+        state[i] = 1;
+        if let Material::Mix { materials, .. } = &m[i] {
+            if !materials.iter().all(|c| visit(c.0 as usize, m, state)) {
+                return false;
+            }
+        }
+        state[i] = 2;
+        true
+    }
+    for (i, d) in descs.iter().enumerate() {
+        if !visit(i, materials, &mut state) {
+            return Err(BuildError::at(
+                &d.loc,
+                "mix materials form a cycle through their \"materials\"",
+            ));
+        }
+    }
+    Ok(())
+}
