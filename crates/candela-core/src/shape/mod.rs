@@ -9,7 +9,8 @@
 //! measure ([`PdfArea`], [`PdfSolidAngle`]).
 //!
 //! Dispatch is a closed enum built by value; the `dispatch!` macro writes the
-//! match arms once. A new shape adds a variant and a file.
+//! match arms once. A new shape adds a variant and a file. Loop subdivision
+//! surfaces are refined into triangle meshes at load time ([`loop_subdivide`]).
 //!
 //! Area sampling need not be uniform: cylinders under general linear maps and
 //! curved bilinear patches sample with a density that varies over the surface,
@@ -27,12 +28,15 @@ mod bilinear_math;
 mod cylinder;
 mod disk;
 mod interval;
+mod loop_subdiv;
 mod mesh;
 mod sphere;
 mod triangle;
 
 #[cfg(test)]
 mod bilinear_tests;
+#[cfg(test)]
+mod loop_subdiv_tests;
 #[cfg(test)]
 mod sampling_tests;
 #[cfg(test)]
@@ -42,6 +46,7 @@ pub use bilinear::{BilinearPatch, BilinearPatchMesh};
 pub use bilinear_math::{intersect_bilinear_patch, invert_bilinear, BilinearIntersection};
 pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use loop_subdiv::{loop_subdivide, LoopSubdivError, LoopSurface};
 pub use mesh::{MeshError, TriangleMesh};
 pub use sphere::Sphere;
 pub use triangle::{intersect_triangle, Triangle, TriangleIntersection, WatertightRay};
