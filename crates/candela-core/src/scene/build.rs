@@ -8,6 +8,7 @@
 mod entities;
 mod geometry;
 mod lights;
+mod shapes;
 mod spectra;
 
 use crate::camera::Camera;
