@@ -178,7 +178,7 @@ impl BilinearPatch {
         let p = self.positions();
         let (mut dpdu, mut dpdv) = partials(&p, uv);
         let c = dpdu.cross(dpdv);
-        if !(c.length_squared() > 0.0) {
+        if c.length_squared().is_nan() || c.length_squared() <= 0.0 {
             // A collapsed edge or corner: take the frame of the patch centre.
             let n = partials(&p, Vec2::splat(0.5));
             let f = Frame::from_z(n.0.cross(n.1).normalize_or(Vec3::Z));
@@ -246,7 +246,7 @@ impl BilinearPatch {
         let p = self.positions();
         let uv = sample_bilinear(u, corner_area_weights(&p));
         let pdf = self.pdf_at(&p, uv);
-        if !(pdf.0 > 0.0) {
+        if pdf.0.is_nan() || pdf.0 <= 0.0 {
             return None;
         }
         let (dpdu, dpdv) = partials(&p, uv);
@@ -296,7 +296,7 @@ fn texture_jacobian_inverse(tex: &[Vec2; 4], uv: Vec2) -> Option<InverseJacobian
     let dst_dv = tex[2].lerp(tex[3], uv.x) - tex[0].lerp(tex[1], uv.x);
     let det = dst_du.perp_dot(dst_dv);
     let scale = dst_du.length() * dst_dv.length();
-    if !(det.abs() > 1e-6 * scale) {
+    if det.is_nan() || det.abs() <= 1e-6 * scale {
         return None;
     }
     let inv = 1.0 / det;
@@ -315,7 +315,7 @@ fn texture_jacobian_inverse(tex: &[Vec2; 4], uv: Vec2) -> Option<InverseJacobian
 /// normal, and the geometric normal follows the shading normal's side
 /// [pbrt-v4 §6.6.2].
 fn set_shading(si: &mut SurfaceInteraction, ns: Vec3, n_corner: &[Vec3; 4], uv: Vec2) {
-    if !(ns.length_squared() > 0.0) {
+    if ns.length_squared().is_nan() || ns.length_squared() <= 0.0 {
         return;
     }
     let ns = ns.normalize();

@@ -82,7 +82,7 @@ pub fn intersect_bilinear_patch(
         let m = n.cross(pa);
         let (t, v) = (m.dot(pb) / det, m.dot(d) / det);
         let v_ok = (-EDGE_EPS..=1.0 + EDGE_EPS).contains(&v);
-        if v_ok && t > 0.0 && best.map_or(true, |(tb, _, _)| t < tb) {
+        if v_ok && t > 0.0 && best.is_none_or(|(tb, _, _)| t < tb) {
             best = Some((t, u, v));
         }
     }
@@ -137,12 +137,12 @@ pub fn corner_area_weights(p: &[Vec3; 4]) -> [f32; 4] {
 const GL8: [(f64, f64); 8] = {
     const X: [f64; 4] = [
         0.183_434_642_495_649_8,
-        0.525_532_409_916_329_0,
+        0.525_532_409_916_329,
         0.796_666_477_413_626_7,
         0.960_289_856_497_536_3,
     ];
     const W: [f64; 4] = [
-        0.362_683_783_378_362_0,
+        0.362_683_783_378_362,
         0.313_706_645_877_887_3,
         0.222_381_034_453_374_5,
         0.101_228_536_290_376_3,

@@ -255,7 +255,7 @@ impl Cylinder {
 
     /// A point with (φ, z) uniform; its density per area is [`Cylinder::pdf_area`].
     pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
-        if !(self.area > 0.0) {
+        if self.area.is_nan() || self.area <= 0.0 {
             return None;
         }
         let z = lerp(u.x, self.z_min, self.z_max);

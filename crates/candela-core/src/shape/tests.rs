@@ -415,7 +415,7 @@ fn cylinder_hits_match_analytic_and_error_bounds_contain_them() {
         // Outward never re-hits the (convex) cylinder; inward only hits the far wall.
         assert!(!cyl.intersect_p(&out, f32::INFINITY));
         let far = cyl.intersect(&back, f32::INFINITY);
-        assert!(far.map_or(true, |o| o.t_hit > 1e-3), "{far:?}");
+        assert!(far.is_none_or(|o| o.t_hit > 1e-3), "{far:?}");
     }
     assert!(hits > 1500, "{hits}");
 }
