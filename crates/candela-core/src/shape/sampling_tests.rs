@@ -81,6 +81,15 @@ fn test_shapes() -> Vec<(&'static str, Shape)> {
             "triangle-rev",
             Shape::Triangle(Triangle::new(tri_mesh(p, vec![0, 1, 2], None, true), 0)),
         ),
+    ]
+    .into_iter()
+    .chain(cylinders_and_patches())
+    .collect()
+}
+
+/// Shapes whose area sampling may be non-uniform.
+fn cylinders_and_patches() -> Vec<(&'static str, Shape)> {
+    vec![
         (
             "cylinder",
             Shape::Cylinder(Cylinder::new(
