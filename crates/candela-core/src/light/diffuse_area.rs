@@ -8,10 +8,11 @@
 //! sampling for spheres seen from outside, area sampling converted by
 //! d²/|cos θ'| otherwise) [pbrt-v4 §6.1]. Emission sampling [Veach 1997,
 //! §8.2; pbrt-v3 `DiffuseAreaLight::Sample_Le`] picks a point by area
-//! (p_pos = 1/A) and a cosine-weighted direction about the normal
-//! (p_dir = cos θ/π); a two-sided light first picks a side with probability
-//! 1/2, so p_dir = cos θ/(2π). Then `β₀ = L·cos θ·A·π/cos θ = πAL = Φ`
-//! (2πAL two-sided) for every sample.
+//! (p_pos = 1/A for uniformly sampled shapes, else the shape's density) and
+//! a cosine-weighted direction about the normal (p_dir = cos θ/π); a
+//! two-sided light first picks a side with probability 1/2, so
+//! p_dir = cos θ/(2π). Then `β₀ = L·cos θ·A·π/cos θ = πAL = Φ` (2πAL
+//! two-sided) for every uniform-area sample.
 
 use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::interaction::Interaction;
@@ -151,7 +152,8 @@ impl DiffuseAreaLight {
     }
 
     /// Densities of [`sample_le`](Self::sample_le) leaving `intr` towards `w`.
-    /// The position density is 1/A (uniform area sampling).
+    /// The position density is the shape's area density at `intr` (1/A for
+    /// uniformly sampled shapes).
     pub fn pdf_le_area(&self, intr: &Interaction, w: Vec3) -> (PdfArea, PdfSolidAngle) {
         debug_assert!(intr.is_surface());
         let cos = intr.n.dot(w);
@@ -162,7 +164,7 @@ impl DiffuseAreaLight {
         } else {
             0.0
         };
-        (PdfArea(1.0 / self.area), PdfSolidAngle(pdf_dir))
+        (self.shape.pdf_area(intr), PdfSolidAngle(pdf_dir))
     }
 
     /// Φ = πAL, doubled when two-sided (seed eq. 二.7).

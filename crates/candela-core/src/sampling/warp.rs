@@ -115,6 +115,62 @@ pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
     x.min(super::ONE_MINUS_EPSILON)
 }
 
+/// Inverse of [`sample_linear`]: the CDF x(a(2 − x) + bx)/(a + b) of the
+/// density ∝ lerp(x, a, b) on [0, 1] [pbrt-v4 §A.4.2].
+#[inline]
+pub fn invert_linear_sample(x: f32, a: f32, b: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    x * (a * (2.0 - x) + b * x) / (a + b)
+}
+
+/// Samples the density on [0,1]² proportional to the bilinear interpolant of
+/// the corner values `w` = [w(0,0), w(1,0), w(0,1), w(1,1)]: the marginal in
+/// y is linear, the conditional in x is linear [pbrt-v4 §A.4.3]. Uniform
+/// when all weights are zero.
+pub fn sample_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
+    if w.iter().sum::<f32>() <= 0.0 {
+        return u;
+    }
+    let y = sample_linear(u.y, w[0] + w[1], w[2] + w[3]);
+    let x = sample_linear(
+        u.x,
+        crate::math::lerp(y, w[0], w[2]),
+        crate::math::lerp(y, w[1], w[3]),
+    );
+    Vec2::new(x, y)
+}
+
+/// Density of [`sample_bilinear`]: 4·bilerp(p, w)/Σw, zero outside [0,1]².
+pub fn bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
+    if !(0.0..=1.0).contains(&p.x) || !(0.0..=1.0).contains(&p.y) {
+        return 0.0;
+    }
+    let sum = w[0] + w[1] + w[2] + w[3];
+    if sum <= 0.0 {
+        return 1.0;
+    }
+    let bilerp = (1.0 - p.x) * (1.0 - p.y) * w[0]
+        + p.x * (1.0 - p.y) * w[1]
+        + (1.0 - p.x) * p.y * w[2]
+        + p.x * p.y * w[3];
+    4.0 * bilerp / sum
+}
+
+/// Inverse of [`sample_bilinear`]: the `u` that maps to `p`.
+pub fn invert_bilinear_sample(p: Vec2, w: [f32; 4]) -> Vec2 {
+    if w.iter().sum::<f32>() <= 0.0 {
+        return p;
+    }
+    Vec2::new(
+        invert_linear_sample(
+            p.x,
+            crate::math::lerp(p.y, w[0], w[2]),
+            crate::math::lerp(p.y, w[1], w[3]),
+        ),
+        invert_linear_sample(p.y, w[0] + w[1], w[2] + w[3]),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -147,5 +203,65 @@ mod tests {
             / n as f64;
         let sigma = (0.5f64 - 4.0 / 9.0).sqrt() / (n as f64).sqrt();
         assert!((m - 2.0 / 3.0).abs() < 5.0 * sigma, "{m}");
+    }
+
+    #[test]
+    fn bilinear_warp_round_trips_and_pdf_integrates_to_one() {
+        let w = [0.2, 1.5, 0.7, 3.0];
+        let mut r = Pcg32::new(7, 4);
+        for _ in 0..10_000 {
+            let u = Vec2::new(r.uniform_f32(), r.uniform_f32());
+            let p = sample_bilinear(u, w);
+            assert!((0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y));
+            let back = invert_bilinear_sample(p, w);
+            assert!(
+                (back - u).abs().max_element() < 2e-4,
+                "{u} -> {p} -> {back}"
+            );
+        }
+        // Midpoint rule: ∫ pdf = 1 (the pdf is bilinear, so the rule is exact).
+        let n = 64;
+        let sum: f64 = (0..n * n)
+            .map(|k| {
+                let p = Vec2::new(
+                    ((k % n) as f32 + 0.5) / n as f32,
+                    ((k / n) as f32 + 0.5) / n as f32,
+                );
+                bilinear_pdf(p, w) as f64
+            })
+            .sum();
+        assert!((sum / (n * n) as f64 - 1.0).abs() < 1e-5);
+        assert_eq!(bilinear_pdf(Vec2::new(1.2, 0.5), w), 0.0);
+    }
+
+    #[test]
+    fn bilinear_warp_matches_its_pdf_chi2() {
+        // 8×8 histogram of samples against the integrated pdf.
+        let w = [0.1, 2.0, 1.0, 0.4];
+        let (n, bins) = (200_000usize, 8usize);
+        let mut r = Pcg32::new(9, 5);
+        let mut hist = vec![0f64; bins * bins];
+        for _ in 0..n {
+            let p = sample_bilinear(Vec2::new(r.uniform_f32(), r.uniform_f32()), w);
+            let (i, j) = (
+                ((p.x * bins as f32) as usize).min(bins - 1),
+                ((p.y * bins as f32) as usize).min(bins - 1),
+            );
+            hist[j * bins + i] += 1.0;
+        }
+        let mut chi2 = 0.0;
+        for j in 0..bins {
+            for i in 0..bins {
+                // The pdf is bilinear: its cell integral is the value at the cell centre / bins².
+                let c = Vec2::new(
+                    (i as f32 + 0.5) / bins as f32,
+                    (j as f32 + 0.5) / bins as f32,
+                );
+                let expected = bilinear_pdf(c, w) as f64 * n as f64 / (bins * bins) as f64;
+                chi2 += (hist[j * bins + i] - expected).powi(2) / expected;
+            }
+        }
+        let p = crate::sampling::chi2::chi2_survival(chi2, bins * bins - 1);
+        assert!(p > 1e-4, "χ² = {chi2}, p = {p}");
     }
 }

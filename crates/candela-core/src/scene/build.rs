@@ -9,6 +9,7 @@ mod entities;
 mod geometry;
 mod lights;
 mod materials;
+mod shapes;
 mod spectra;
 mod textures;
 

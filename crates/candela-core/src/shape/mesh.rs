@@ -16,8 +16,11 @@ pub enum MeshError {
     /// The index count is not a multiple of three.
     #[error("triangle mesh has {0} indices, not a multiple of 3")]
     IndexCount(usize),
+    /// The index count is not a multiple of four (bilinear patch meshes).
+    #[error("bilinear patch mesh has {0} indices, not a multiple of 4")]
+    PatchIndexCount(usize),
     /// An index refers past the vertex arrays.
-    #[error("triangle mesh index {index} out of range for {vertices} vertices")]
+    #[error("mesh vertex index {index} out of range for {vertices} vertices")]
     IndexOutOfRange {
         /// The offending index.
         index: u32,
@@ -25,7 +28,7 @@ pub enum MeshError {
         vertices: usize,
     },
     /// A per-vertex attribute array has the wrong length.
-    #[error("triangle mesh attribute \"{name}\" has {len} entries, expected {expected}")]
+    #[error("mesh attribute \"{name}\" has {len} entries, expected {expected}")]
     AttributeLength {
         /// Attribute name (`N`, `uv`, `faceIndices`).
         name: &'static str,
@@ -66,20 +69,9 @@ impl TriangleMesh {
         uv: Option<Vec<Vec2>>,
         face_indices: Option<Vec<i32>>,
     ) -> Result<Self, MeshError> {
-        validate(&indices, p.len(), &n, &uv, &face_indices)?;
+        validate(3, &indices, p.len(), &n, &uv, &face_indices)?;
         let p = p.iter().map(|&q| render_from_object.point(q)).collect();
-        let n = n.map(|ns| {
-            ns.iter()
-                .map(|&v| {
-                    let w = render_from_object.normal(v);
-                    if reverse_orientation {
-                        -w
-                    } else {
-                        w
-                    }
-                })
-                .collect()
-        });
+        let n = n.map(|ns| render_normals(render_from_object, reverse_orientation, &ns));
         Ok(Self {
             p,
             n,
@@ -115,16 +107,37 @@ impl TriangleMesh {
     }
 }
 
-/// Checks index range and attribute lengths.
-fn validate(
+/// Normals moved to render space (inverse transpose), negated when the
+/// orientation is reversed [pbrt-v4 `TriangleMesh`, `BilinearPatchMesh`].
+pub(super) fn render_normals(t: &Transform, reverse_orientation: bool, ns: &[Vec3]) -> Vec<Vec3> {
+    ns.iter()
+        .map(|&v| {
+            let w = t.normal(v);
+            if reverse_orientation {
+                -w
+            } else {
+                w
+            }
+        })
+        .collect()
+}
+
+/// Checks index count and range and attribute lengths of a mesh whose
+/// faces have `arity` vertices (3: triangles, 4: bilinear patches).
+pub(super) fn validate(
+    arity: usize,
     indices: &[u32],
     nv: usize,
     n: &Option<Vec<Vec3>>,
     uv: &Option<Vec<Vec2>>,
     face_indices: &Option<Vec<i32>>,
 ) -> Result<(), MeshError> {
-    if !indices.len().is_multiple_of(3) {
-        return Err(MeshError::IndexCount(indices.len()));
+    if !indices.len().is_multiple_of(arity) {
+        return Err(if arity == 4 {
+            MeshError::PatchIndexCount(indices.len())
+        } else {
+            MeshError::IndexCount(indices.len())
+        });
     }
     if let Some(&index) = indices.iter().find(|&&i| i as usize >= nv) {
         return Err(MeshError::IndexOutOfRange {
@@ -150,7 +163,7 @@ fn validate(
         check("uv", uv.len(), nv)?;
     }
     if let Some(f) = face_indices {
-        check("faceIndices", f.len(), indices.len() / 3)?;
+        check("faceIndices", f.len(), indices.len() / arity)?;
     }
     Ok(())
 }

@@ -9,8 +9,12 @@
 //! measure ([`PdfArea`], [`PdfSolidAngle`]).
 //!
 //! Dispatch is a closed enum built by value; the `dispatch!` macro writes the
-//! match arms once. New shapes (cylinder, bilinear patch) add a variant and a
-//! file.
+//! match arms once. A new shape adds a variant and a file. Loop subdivision
+//! surfaces are refined into triangle meshes at load time ([`loop_subdivide`]).
+//!
+//! Area sampling need not be uniform: cylinders under general linear maps and
+//! curved bilinear patches sample with a density that varies over the surface,
+//! so [`Shape::pdf_area`] evaluates it at the point.
 //!
 //! Normal orientation: the geometric normal points to the object's outside
 //! (the side `∂p/∂u × ∂p/∂v` points to in object space) and is flipped by
@@ -19,18 +23,30 @@
 //! normals, the geometric normal follows the interpolated shading normal, as
 //! in pbrt-v4.
 
+mod bilinear;
+mod bilinear_math;
+mod cylinder;
 mod disk;
 mod interval;
+mod loop_subdiv;
 mod mesh;
 mod sphere;
 mod triangle;
 
 #[cfg(test)]
+mod bilinear_tests;
+#[cfg(test)]
+mod loop_subdiv_tests;
+#[cfg(test)]
 mod sampling_tests;
 #[cfg(test)]
 mod tests;
 
+pub use bilinear::{BilinearPatch, BilinearPatchMesh};
+pub use bilinear_math::{intersect_bilinear_patch, invert_bilinear, BilinearIntersection};
+pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use loop_subdiv::{loop_subdivide, LoopSubdivError, LoopSurface};
 pub use mesh::{MeshError, TriangleMesh};
 pub use sphere::Sphere;
 pub use triangle::{intersect_triangle, Triangle, TriangleIntersection, WatertightRay};
@@ -131,6 +147,10 @@ pub enum Shape {
     Sphere(Sphere),
     /// A (partial) disk or annulus.
     Disk(Disk),
+    /// A (partial) cylinder.
+    Cylinder(Cylinder),
+    /// One patch of a bilinear patch mesh.
+    BilinearPatch(BilinearPatch),
 }
 
 /// Expands to a match forwarding `$call` to the concrete shape.
@@ -140,6 +160,8 @@ macro_rules! dispatch {
             Shape::Triangle($s) => $call,
             Shape::Sphere($s) => $call,
             Shape::Disk($s) => $call,
+            Shape::Cylinder($s) => $call,
+            Shape::BilinearPatch($s) => $call,
         }
     };
 }
@@ -202,14 +224,19 @@ impl Shape {
         dispatch!(self, s => s.intersect_p(ray, t_max))
     }
 
-    /// A point sampled uniformly by area; `None` for degenerate shapes.
+    /// A point sampled by area (uniformly, except for the shapes named in
+    /// the module doc); `None` for degenerate shapes.
     pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
         dispatch!(self, s => s.sample_area(u))
     }
 
     /// Density of [`Shape::sample_area`] at a point on the shape.
-    pub fn pdf_area(&self, _intr: &Interaction) -> PdfArea {
-        PdfArea(1.0 / self.area())
+    pub fn pdf_area(&self, intr: &Interaction) -> PdfArea {
+        match self {
+            Shape::Cylinder(c) => c.pdf_area(intr),
+            Shape::BilinearPatch(b) => b.pdf_area(intr),
+            _ => PdfArea(1.0 / self.area()),
+        }
     }
 
     /// A point sampled with density with respect to solid angle at `ctx.p`.
@@ -226,7 +253,7 @@ impl Shape {
             Shape::Sphere(s) => s.pdf_from(ctx, wi),
             _ => {
                 let hit = self.intersect(&ctx.spawn_ray(wi), f32::INFINITY);
-                pdf_from_hit(ctx, wi, hit, self.area())
+                pdf_from_hit(ctx, wi, hit, |it| self.pdf_area(it))
             }
         }
     }
@@ -251,20 +278,21 @@ pub(crate) fn area_sample_to_solid_angle(
     Some(ShapeSampleSa { intr: ss.intr, pdf })
 }
 
-/// Solid-angle density of uniform area sampling for direction `wi`, given
-/// the hit of the ray from `ctx` along `wi` (0 when it missed).
+/// Solid-angle density of area sampling for direction `wi`, given the hit
+/// of the ray from `ctx` along `wi` (0 when it missed) and the area density
+/// at a point.
 pub(crate) fn pdf_from_hit(
     ctx: &ShapeSampleContext,
     wi: Vec3,
     hit: Option<ShapeIntersection>,
-    area: f32,
+    pdf_area: impl FnOnce(&Interaction) -> PdfArea,
 ) -> PdfSolidAngle {
     let Some(isect) = hit else {
         return PdfSolidAngle(0.0);
     };
     let dist2 = ctx.p.distance_squared(isect.si.it.p);
     let cos = isect.si.it.n.dot(wi.normalize()).abs();
-    let pdf = pdf_area_to_solid_angle(PdfArea(1.0 / area), dist2, cos);
+    let pdf = pdf_area_to_solid_angle(pdf_area(&isect.si.it), dist2, cos);
     if pdf.0.is_finite() {
         pdf
     } else {

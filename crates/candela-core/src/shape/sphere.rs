@@ -306,7 +306,7 @@ impl Sphere {
     pub fn pdf_from(&self, ctx: &ShapeSampleContext, wi: Vec3) -> PdfSolidAngle {
         if !self.uses_cone(ctx) {
             let hit = self.intersect(&ctx.spawn_ray(wi), f32::INFINITY);
-            return pdf_from_hit(ctx, wi, hit, self.area());
+            return pdf_from_hit(ctx, wi, hit, |_| PdfArea(1.0 / self.area()));
         }
         let (c, r) = self.render_center_radius();
         let d = c - ctx.p;
@@ -338,7 +338,7 @@ pub(super) fn phi_of(p: Vec3) -> f32 {
 
 /// ∂n/∂u, ∂n/∂v from the first and second fundamental forms
 /// [pbrt-v4 eq. 6.10, the Weingarten equations].
-fn weingarten(dpdu: Vec3, dpdv: Vec3, duu: Vec3, duv: Vec3, dvv: Vec3) -> (Vec3, Vec3) {
+pub(super) fn weingarten(dpdu: Vec3, dpdv: Vec3, duu: Vec3, duv: Vec3, dvv: Vec3) -> (Vec3, Vec3) {
     let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
     let n = dpdu.cross(dpdv).normalize_or_zero();
     let (e, f, g) = (n.dot(duu), n.dot(duv), n.dot(dvv));

@@ -358,3 +358,110 @@ fn triangle_normal_orientation_rules() {
         .unwrap();
     assert_eq!(h.si.it.n, Vec3::Z);
 }
+
+#[test]
+fn cylinder_hits_match_analytic_and_error_bounds_contain_them() {
+    let (c, s) = (Vec3::new(-2.0, 1.0, 4.0), 1.7);
+    let to_obj = similarity(s, c).inverse();
+    let cyl = Cylinder::new(similarity(s, c), false, 0.8, -0.5, 1.2, 360.0);
+    let mut r = Pcg32::new(43, 1);
+    let mut hits = 0;
+    for _ in 0..5000 {
+        let o = c + dir(&mut r) * (s * (2.0 + 4.0 * r.uniform_f32()));
+        let ray = Ray::new(o, c + dir(&mut r) * s * 0.9 - o);
+        // Object-space f64 quadratic: |(o + t d)_xy|² = r².
+        let (oo, dd) = (
+            to_obj.point(ray.o).as_dvec3(),
+            to_obj.vector(ray.d).as_dvec3(),
+        );
+        let a = dd.x * dd.x + dd.y * dd.y;
+        let b = 2.0 * (oo.x * dd.x + oo.y * dd.y);
+        let cc = oo.x * oo.x + oo.y * oo.y - 0.64;
+        let disc = b * b - 4.0 * a * cc;
+        let roots = if disc < 0.0 {
+            vec![]
+        } else {
+            vec![
+                (-b - disc.sqrt()) / (2.0 * a),
+                (-b + disc.sqrt()) / (2.0 * a),
+            ]
+        };
+        let z_of = |t: f64| oo.z + t * dd.z;
+        let t_want = roots
+            .iter()
+            .copied()
+            .find(|&t| t > 0.0 && (-0.5..=1.2).contains(&z_of(t)));
+        // Skip rays grazing the rims or the silhouette.
+        let near_rim = |t: f64| (z_of(t) + 0.5).abs() < 1e-3 || (z_of(t) - 1.2).abs() < 1e-3;
+        if roots.iter().any(|&t| t > 0.0 && near_rim(t)) || (disc >= 0.0 && disc < 1e-6 * b * b) {
+            continue;
+        }
+        let got = cyl.intersect(&ray, f32::INFINITY);
+        assert_eq!(got.is_some(), t_want.is_some(), "{ray:?}");
+        let (Some(h), Some(t)) = (got, t_want) else {
+            continue;
+        };
+        hits += 1;
+        assert!((h.t_hit as f64 - t).abs() < 1e-4 * t, "{} vs {t}", h.t_hit);
+        // The error box meets the render-space cylinder: check in object space.
+        let p_obj = to_obj.point(h.si.p()).as_dvec3();
+        let rad = (p_obj.x * p_obj.x + p_obj.y * p_obj.y).sqrt();
+        assert!((rad - 0.8).abs() <= h.si.it.p_error.length() as f64 / s as f64 + 1e-6);
+        // Outward normal: away from the axis.
+        let radial = similarity(s, c).vector(Vec3::new(p_obj.x as f32, p_obj.y as f32, 0.0));
+        assert!(h.si.n().dot(radial) > 0.0, "outward normal");
+        let out = h.si.spawn_ray(h.si.n() + dir(&mut r) * 0.9);
+        let back = h.si.spawn_ray(-h.si.n() + dir(&mut r) * 0.9);
+        // Outward never re-hits the (convex) cylinder; inward only hits the far wall.
+        assert!(!cyl.intersect_p(&out, f32::INFINITY));
+        let far = cyl.intersect(&back, f32::INFINITY);
+        assert!(far.is_none_or(|o| o.t_hit > 1e-3), "{far:?}");
+    }
+    assert!(hits > 1500, "{hits}");
+}
+
+#[test]
+fn clipped_cylinder_respects_z_and_phi_and_area() {
+    let cyl = Cylinder::new(Arc::new(Transform::IDENTITY), false, 2.0, 1.0, -0.5, 200.0);
+    let area = 2.0 * 1.5 * 200f32.to_radians();
+    assert!((cyl.area() - area).abs() < 1e-5 * area, "{}", cyl.area());
+    let mut r = Pcg32::new(47, 1);
+    let mut hits = 0;
+    for _ in 0..5000 {
+        let o = dir(&mut r) * 5.0;
+        let ray = Ray::new(o, dir(&mut r) * 0.5 - o);
+        if let Some(h) = cyl.intersect(&ray, f32::INFINITY) {
+            let p = h.si.p();
+            let phi = sphere::phi_of(p);
+            assert!(p.z >= -0.5 - 1e-5 && p.z <= 1.0 + 1e-5, "{p}");
+            assert!(phi <= 200f32.to_radians() + 1e-4, "{phi}");
+            assert!((h.si.it.uv.x - phi / 200f32.to_radians()).abs() < 1e-4);
+            assert!((h.si.it.uv.y - (p.z + 0.5) / 1.5).abs() < 1e-4);
+            hits += 1;
+        }
+    }
+    assert!(hits > 1000);
+    // Rays along the axis never hit the side.
+    assert!(!cyl.intersect_p(&Ray::new(Vec3::new(0.3, 0.2, -5.0), Vec3::Z), f32::INFINITY));
+}
+
+#[test]
+fn cylinder_area_under_anisotropic_scale_matches_quadrature() {
+    // x stretched by 3: an elliptic cylinder with semi-axes 3r and r.
+    let m = Transform::scale(Vec3::new(3.0, 1.0, 2.0));
+    let cyl = Cylinder::new(Arc::new(m), false, 1.0, 0.0, 1.0, 360.0);
+    // Perimeter of the ellipse by fine midpoint quadrature, times height 2.
+    let n = 200_000;
+    let per: f64 = (0..n)
+        .map(|i| {
+            let phi = (i as f64 + 0.5) / n as f64 * 2.0 * std::f64::consts::PI;
+            (3.0 * phi.sin()).hypot(phi.cos()) * 2.0 * std::f64::consts::PI / n as f64
+        })
+        .sum();
+    let exact = per * 2.0;
+    assert!(
+        (cyl.area() as f64 - exact).abs() < 1e-5 * exact,
+        "{} vs {exact}",
+        cyl.area()
+    );
+}

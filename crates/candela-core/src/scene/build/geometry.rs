@@ -2,14 +2,13 @@
 
 use super::lights::area_light;
 use super::materials::MaterialNames;
+use super::shapes::build_shape;
 use super::BuildError;
 use crate::interaction::{LightId, MaterialId};
 use crate::light::Light;
-use crate::math::{Transform, Vec2, Vec3};
+use crate::math::Transform;
 use crate::scene::Primitive;
-use crate::shape::{Disk, Shape, Sphere, Triangle, TriangleMesh};
 use candela_scene::{MaterialRef, SceneDescription, ShapeDesc};
-use std::sync::Arc;
 
 /// All primitives (instances flattened) and the area lights they carry.
 pub fn primitives(
@@ -19,14 +18,7 @@ pub fn primitives(
     let mut prims = Vec::new();
     let mut lights = Vec::new();
     for s in &desc.shapes {
-        add_shape(
-            desc,
-            s,
-            &Transform::IDENTITY,
-            names,
-            &mut prims,
-            &mut lights,
-        )?;
+        add_shape(s, &Transform::IDENTITY, names, &mut prims, &mut lights)?;
     }
     for inst in &desc.instances {
         let def = desc
@@ -45,14 +37,13 @@ pub fn primitives(
             if let Some(a) = &s.area_light {
                 return Err(BuildError::at(&a.loc, "area lights inside object instances are not supported (pbrt-v4 rejects them too)"));
             }
-            add_shape(desc, s, &t, names, &mut prims, &mut lights)?;
+            add_shape(s, &t, names, &mut prims, &mut lights)?;
         }
     }
     Ok((prims, lights))
 }
 
 fn add_shape(
-    desc: &SceneDescription,
     s: &ShapeDesc,
     parent: &Transform,
     names: &MaterialNames,
@@ -83,7 +74,7 @@ fn add_shape(
     let object = Transform::from_rows_f64(s.render_from_object.m)
         .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
     let render_from_object = parent.then_after(&object);
-    let shapes = build_shape(desc, s, &render_from_object)?;
+    let shapes = build_shape(s, &render_from_object)?;
     for shape in shapes {
         let area_light = match &s.area_light {
             Some(a) => {
@@ -99,128 +90,4 @@ fn add_shape(
         });
     }
     Ok(())
-}
-
-fn build_shape(
-    desc: &SceneDescription,
-    s: &ShapeDesc,
-    t: &Transform,
-) -> Result<Vec<Shape>, BuildError> {
-    let p = &s.params;
-    let ro = s.reverse_orientation;
-    Ok(match s.name.as_str() {
-        "sphere" => {
-            let r = p.get_float("radius", 1.0)?;
-            let (zmin, zmax, phimax) = (
-                p.get_float("zmin", -r)?,
-                p.get_float("zmax", r)?,
-                p.get_float("phimax", 360.0)?,
-            );
-            vec![Shape::Sphere(Sphere::new(
-                Arc::new(*t),
-                ro,
-                r,
-                zmin,
-                zmax,
-                phimax,
-            ))]
-        }
-        "disk" => {
-            let (h, r, ri, phimax) = (
-                p.get_float("height", 0.0)?,
-                p.get_float("radius", 1.0)?,
-                p.get_float("innerradius", 0.0)?,
-                p.get_float("phimax", 360.0)?,
-            );
-            vec![Shape::Disk(Disk::new(Arc::new(*t), ro, h, r, ri, phimax))]
-        }
-        "trianglemesh" => {
-            let pos = p
-                .get_point3s("P")?
-                .ok_or_else(|| BuildError::at(&s.loc, "trianglemesh needs \"point3 P\""))?;
-            let indices =
-                match p.get_ints("indices")? {
-                    Some(i) => i,
-                    None if pos.len() == 3 => vec![0, 1, 2],
-                    None => return Err(BuildError::at(
-                        &s.loc,
-                        "trianglemesh needs \"integer indices\" unless it has exactly 3 vertices",
-                    )),
-                };
-            let n = p.get_normals("N")?;
-            let uv = p.get_point2s("uv")?;
-            let face = p.get_ints("faceIndices")?;
-            mesh_shapes(s, t, pos, indices, n, uv, face)?
-        }
-        "plymesh" => {
-            let file = p
-                .get_filename("filename")?
-                .ok_or_else(|| BuildError::at(&s.loc, "plymesh needs \"string filename\""))?;
-            if p.get_texture("displacement").is_some() {
-                return Err(BuildError::at(
-                    &s.loc,
-                    "plymesh \"displacement\" is not supported yet",
-                ));
-            }
-            let m = candela_scene::read_ply(&file)
-                .map_err(|e| BuildError::at(&s.loc, format!("{e}")))?;
-            let idx = m.indices.iter().map(|&i| i as i32).collect();
-            mesh_shapes(s, t, m.positions, idx, m.normals, m.uvs, m.face_indices)?
-        }
-        other => {
-            let _ = desc;
-            return Err(BuildError::at(&s.loc, format!("shape \"{other}\" is not supported yet (supported: trianglemesh, plymesh, sphere, disk)")));
-        }
-    })
-}
-
-fn mesh_shapes(
-    s: &ShapeDesc,
-    t: &Transform,
-    pos: Vec<[f32; 3]>,
-    indices: Vec<i32>,
-    n: Option<Vec<[f32; 3]>>,
-    uv: Option<Vec<[f32; 2]>>,
-    face: Option<Vec<i32>>,
-) -> Result<Vec<Shape>, BuildError> {
-    if !indices.len().is_multiple_of(3) {
-        return Err(BuildError::at(
-            &s.loc,
-            format!(
-                "triangle mesh has {} indices, not a multiple of 3",
-                indices.len()
-            ),
-        ));
-    }
-    if let Some(bad) = indices.iter().find(|&&i| i < 0 || i as usize >= pos.len()) {
-        return Err(BuildError::at(
-            &s.loc,
-            format!(
-                "vertex index {bad} out of range (mesh has {} vertices)",
-                pos.len()
-            ),
-        ));
-    }
-    if n.as_ref().is_some_and(|n| n.len() != pos.len())
-        || uv.as_ref().is_some_and(|u| u.len() != pos.len())
-    {
-        return Err(BuildError::at(
-            &s.loc,
-            "\"N\" and \"uv\" must have one entry per vertex of \"P\"",
-        ));
-    }
-    let mesh = TriangleMesh::new(
-        t,
-        s.reverse_orientation,
-        indices.iter().map(|&i| i as u32).collect(),
-        pos.iter().map(|p| Vec3::from_array(*p)).collect(),
-        n.map(|n| n.iter().map(|v| Vec3::from_array(*v)).collect()),
-        uv.map(|u| u.iter().map(|v| Vec2::from_array(*v)).collect()),
-        face,
-    )
-    .map_err(|e| BuildError::at(&s.loc, format!("invalid triangle mesh: {e}")))?;
-    Ok(Triangle::all(&Arc::new(mesh))
-        .into_iter()
-        .map(Shape::Triangle)
-        .collect())
 }
