@@ -1,17 +1,18 @@
 //! Materials, shapes and area lights (instances are flattened into world space).
 
+use super::coated::{coated_conductor, coated_diffuse, conductor_spec};
 use super::lights::area_light;
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
 use crate::interaction::{LightId, MaterialId};
 use crate::light::Light;
-use crate::material::{ConductorSpec, Material, Roughness};
+use crate::material::{Material, Roughness};
 use crate::math::{Transform, Vec2, Vec3};
 use crate::scene::Primitive;
 use crate::shape::{Disk, Shape, Sphere, Triangle, TriangleMesh};
-use crate::spectrum::{named_spectrum, ColorSpace, Spectrum};
+use crate::spectrum::{ColorSpace, Spectrum};
 use crate::texture::{FloatTexture, SpectrumTexture};
-use candela_scene::{Loc, MaterialDesc, MaterialRef, SceneDescription, ShapeDesc};
+use candela_scene::{Loc, MaterialDesc, MaterialRef, ParamType, SceneDescription, ShapeDesc};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -42,7 +43,11 @@ pub fn materials(desc: &SceneDescription) -> Result<(Vec<Material>, MaterialName
     Ok((out, (names, default)))
 }
 
-fn float_tex(m: &MaterialDesc, name: &str, default: f32) -> Result<FloatTexture, BuildError> {
+pub(super) fn float_tex(
+    m: &MaterialDesc,
+    name: &str,
+    default: f32,
+) -> Result<FloatTexture, BuildError> {
     if let Some(t) = m.params.get_texture(name) {
         return Err(BuildError::at(
             &m.loc,
@@ -52,7 +57,7 @@ fn float_tex(m: &MaterialDesc, name: &str, default: f32) -> Result<FloatTexture,
     Ok(FloatTexture::Constant(m.params.get_float(name, default)?))
 }
 
-fn spectrum_tex(
+pub(super) fn spectrum_tex(
     m: &MaterialDesc,
     name: &str,
     kind: SpectrumKind,
@@ -78,14 +83,25 @@ fn roughness(m: &MaterialDesc) -> Result<Roughness, BuildError> {
     })
 }
 
-/// Index of refraction: a float or a spectrum (pbrt-v4 accepts both).
+/// Index of refraction `eta`.
 fn eta(m: &MaterialDesc) -> Result<Spectrum, BuildError> {
-    if let Some(v) = m.params.get_floats("eta")? {
+    eta_param(m, "eta")
+}
+
+/// Index of refraction `name`: a float or a spectrum (pbrt-v4 accepts both), default 1.5.
+pub(super) fn eta_param(m: &MaterialDesc, name: &str) -> Result<Spectrum, BuildError> {
+    // Ask for floats only when the parameter is one: `get_floats` rejects a spectrum.
+    let is_float = m.params.get(name).is_some_and(|p| p.ty == ParamType::Float);
+    if let Some(v) = is_float
+        .then(|| m.params.get_floats(name))
+        .transpose()?
+        .flatten()
+    {
         return Ok(Spectrum::Constant(v.first().copied().unwrap_or(1.5)));
     }
     let cs = color_space(&m.color_space, &m.loc)?;
     Ok(
-        spectrum_param(&m.params, "eta", SpectrumKind::Unbounded, cs)?
+        spectrum_param(&m.params, name, SpectrumKind::Unbounded, cs)?
             .unwrap_or(Spectrum::Constant(1.5)),
     )
 }
@@ -109,28 +125,13 @@ fn material(m: &MaterialDesc) -> Result<Material, BuildError> {
             reflectance: spectrum_tex(m, "reflectance", SpectrumKind::Albedo)?
                 .unwrap_or(SpectrumTexture::Constant(Spectrum::Constant(0.5))),
         },
-        "conductor" => {
-            let spec = match spectrum_tex(m, "reflectance", SpectrumKind::Albedo)? {
-                Some(r) => ConductorSpec::Reflectance(r),
-                None => {
-                    let cu = |n: &str| named_spectrum(n).map(SpectrumTexture::Constant).ok_or_else(|| BuildError::Other(format!("missing built-in spectrum {n}")));
-                    let eta = match spectrum_tex(m, "eta", SpectrumKind::Unbounded)? {
-                        Some(e) => e,
-                        None => cu("metal-Cu-eta")?,
-                    };
-                    let k = match spectrum_tex(m, "k", SpectrumKind::Unbounded)? {
-                        Some(k) => k,
-                        None => cu("metal-Cu-k")?,
-                    };
-                    ConductorSpec::EtaK { eta, k }
-                }
-            };
-            Material::Conductor { spec, roughness: roughness(m)? }
-        }
+        "conductor" => Material::Conductor { spec: conductor_spec(m, "eta", "k")?, roughness: roughness(m)? },
+        "coateddiffuse" => coated_diffuse(m)?,
+        "coatedconductor" => coated_conductor(m)?,
         "dielectric" => Material::Dielectric { eta: eta(m)?, roughness: roughness(m)? },
         "thindielectric" => Material::ThinDielectric { eta: eta(m)? },
         "interface" | "" | "none" => Material::Interface,
-        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, conductor, dielectric, thindielectric, interface)"))),
+        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, conductor, coateddiffuse, coatedconductor, dielectric, thindielectric, interface)"))),
     })
 }
 
