@@ -11,6 +11,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 pub mod fresnel;
+pub mod layered;
 pub mod microfacet;
 mod thin_dielectric;
 
@@ -20,6 +21,7 @@ mod tests;
 pub use conductor::ConductorBxdf;
 pub use dielectric::DielectricBxdf;
 pub use diffuse::DiffuseBxdf;
+pub use layered::{CoatedConductorBxdf, CoatedDiffuseBxdf, LayerParams, LayeredBxdf};
 pub use microfacet::TrowbridgeReitz;
 pub use thin_dielectric::ThinDielectricBxdf;
 
@@ -40,12 +42,12 @@ pub enum TransportMode {
 }
 
 impl TransportMode {
-    /// The adjoint mode: what the walker from the other end carries.
+    /// The other mode: what a path traced from the opposite end carries.
     #[inline]
-    pub fn flip(self) -> Self {
+    pub fn adjoint(self) -> Self {
         match self {
-            TransportMode::Radiance => TransportMode::Importance,
-            TransportMode::Importance => TransportMode::Radiance,
+            Self::Radiance => Self::Importance,
+            Self::Importance => Self::Radiance,
         }
     }
 }
@@ -163,6 +165,10 @@ pub enum Bxdf {
     Dielectric(DielectricBxdf),
     /// Thin dielectric sheet: delta reflection and straight transmission.
     ThinDielectric(ThinDielectricBxdf),
+    /// Dielectric coating over a Lambertian base (stochastic layered model).
+    CoatedDiffuse(CoatedDiffuseBxdf),
+    /// Dielectric coating over a conductor (stochastic layered model).
+    CoatedConductor(CoatedConductorBxdf),
 }
 
 /// Writes a `match` over every [`Bxdf`] variant that forwards to the inner model.
@@ -173,6 +179,8 @@ macro_rules! dispatch_bxdf {
             Bxdf::Conductor($b) => $e,
             Bxdf::Dielectric($b) => $e,
             Bxdf::ThinDielectric($b) => $e,
+            Bxdf::CoatedDiffuse($b) => $e,
+            Bxdf::CoatedConductor($b) => $e,
         }
     };
 }
@@ -253,6 +261,18 @@ impl From<DielectricBxdf> for Bxdf {
 impl From<ThinDielectricBxdf> for Bxdf {
     fn from(b: ThinDielectricBxdf) -> Self {
         Self::ThinDielectric(b)
+    }
+}
+
+impl From<CoatedDiffuseBxdf> for Bxdf {
+    fn from(b: CoatedDiffuseBxdf) -> Self {
+        Self::CoatedDiffuse(b)
+    }
+}
+
+impl From<CoatedConductorBxdf> for Bxdf {
+    fn from(b: CoatedConductorBxdf) -> Self {
+        Self::CoatedConductor(b)
     }
 }
 

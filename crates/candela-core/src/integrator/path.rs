@@ -8,13 +8,19 @@
 //! strategy and weight 1. Paths end by Russian roulette on the throughput
 //! (corrected by the accumulated η² so refraction does not bias it, as pbrt-v4)
 //! or at `maxdepth` scattering events.
+//!
+//! Stochastic layered BSDFs return samples whose pdf is only proportional to
+//! the true density (`pdf_is_proportional`): f/p is still the right throughput
+//! weight, but MIS on the emitter the sample hits must use the same density
+//! that next-event estimation uses, `Bsdf::pdf`, or the two weights of one
+//! direction would not sum to one [pbrt-v4 §14.3.3, `PathIntegrator::Li`].
 
 use super::{driver, Integrator, PixelEstimator, RenderContext};
-use crate::bsdf::{BsdfSample, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
 use crate::film::{RgbFilm, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
 use crate::light::{LightSampleContext, LightType};
-use crate::math::Ray;
+use crate::math::{Ray, Vec3};
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::scene::Scene;
@@ -117,7 +123,7 @@ impl PixelEstimator for PathIntegrator {
             ) else {
                 break;
             };
-            self.scatter(&si, &bs, &mut st);
+            self.scatter(&si, &bsdf, wo, &bs, &mut st);
             ray = si.spawn_ray(bs.wi);
             if !self.russian_roulette(&mut st, sampler) {
                 break;
@@ -179,8 +185,8 @@ impl PathIntegrator {
         &self,
         scene: &Scene,
         si: &SurfaceInteraction,
-        bsdf: &crate::bsdf::Bsdf,
-        wo: crate::math::Vec3,
+        bsdf: &Bsdf,
+        wo: Vec3,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
     ) -> SampledSpectrum {
@@ -215,9 +221,22 @@ impl PathIntegrator {
     }
 
     /// Updates throughput and MIS state after a BSDF sample.
-    fn scatter(&self, si: &SurfaceInteraction, bs: &BsdfSample, st: &mut PathState) {
+    fn scatter(
+        &self,
+        si: &SurfaceInteraction,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        bs: &BsdfSample,
+        st: &mut PathState,
+    ) {
         st.beta *= bs.f * (bs.wi.dot(si.shading.n).abs() / bs.pdf.0);
-        st.prev_pdf = bs.pdf.0;
+        // A specular bounce takes no MIS, so its density is never needed.
+        st.prev_pdf = if bs.pdf_is_proportional && !bs.is_specular() {
+            bsdf.pdf(wo, bs.wi, TransportMode::Radiance, SampleFlags::ALL)
+                .0
+        } else {
+            bs.pdf.0
+        };
         st.specular_bounce = bs.is_specular();
         st.any_non_specular |= !bs.is_specular();
         if bs.is_transmission() {

@@ -4,7 +4,9 @@
 //! its textures at the hit for the path's wavelengths. Spectrally varying
 //! indices of refraction make the path's secondary wavelengths meaningless
 //! after refraction, so the dielectric terminates them (keeping only the hero
-//! wavelength, [Wilkie et al. 2014]).
+//! wavelength, [Wilkie et al. 2014]). The coated materials put a
+//! [`Coating`] over a Lambertian or conductor base and evaluate to the
+//! stochastic layered BxDF of pbrt-v4 §14.3.
 //!
 //! The scene resolves a [`Material::Mix`] to one of its materials per hit
 //! ([`mix_choice`]) and applies a material's `displacement` ([`apply_bump`])
@@ -17,7 +19,8 @@ pub use bump::{apply_bump, bump_map};
 pub use mix::mix_choice;
 
 use crate::bsdf::{
-    Bsdf, Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, ThinDielectricBxdf, TrowbridgeReitz,
+    Bsdf, Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, LayerParams, LayeredBxdf,
+    ThinDielectricBxdf, TrowbridgeReitz,
 };
 use crate::interaction::{MaterialId, SurfaceInteraction};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
@@ -59,6 +62,49 @@ pub enum ConductorSpec {
     Reflectance(SpectrumTexture),
 }
 
+/// The dielectric coating and in-between medium of the coated materials
+/// (pbrt-v4 `coateddiffuse` / `coatedconductor` parameters).
+#[derive(Clone, Debug)]
+pub struct Coating {
+    /// Index of refraction of the coating (`eta` / `interface.eta`, default 1.5).
+    pub eta: Spectrum,
+    /// Coating roughness (`roughness` / `interface.roughness`, default 0).
+    pub roughness: Roughness,
+    /// Slab thickness (`thickness`, default 0.01).
+    pub thickness: FloatTexture,
+    /// Medium single-scattering albedo (`albedo`, default 0: no scattering medium).
+    pub albedo: SpectrumTexture,
+    /// Medium Henyey–Greenstein asymmetry (`g`, default 0).
+    pub g: FloatTexture,
+    /// Maximum scattering events of one walk (`maxdepth`, default 10).
+    pub max_depth: u32,
+    /// Walks averaged per evaluation (`nsamples`, default 1).
+    pub n_samples: u32,
+}
+
+impl Coating {
+    /// The coating BxDF and the layer parameters at a hit; a spectrally
+    /// varying index terminates the secondary wavelengths, as for dielectrics.
+    fn evaluate(
+        &self,
+        ctx: &TextureEvalContext,
+        lambda: &mut SampledWavelengths,
+    ) -> (DielectricBxdf, LayerParams) {
+        let top = DielectricBxdf::new(
+            hero_eta(&self.eta, lambda),
+            self.roughness.distribution(ctx),
+        );
+        let params = LayerParams {
+            thickness: self.thickness.evaluate(ctx),
+            albedo: self.albedo.evaluate(ctx, lambda).clamp(0.0, 1.0),
+            g: self.g.evaluate(ctx).clamp(-1.0, 1.0),
+            max_depth: self.max_depth,
+            n_samples: self.n_samples,
+        };
+        (top, params)
+    }
+}
+
 /// The closed set of materials.
 #[derive(Clone, Debug)]
 pub enum Material {
@@ -91,6 +137,26 @@ pub enum Material {
     ThinDielectric {
         /// Index of refraction.
         eta: Spectrum,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
+    },
+    /// Dielectric coating over a Lambertian base.
+    CoatedDiffuse {
+        /// Albedo of the base.
+        reflectance: SpectrumTexture,
+        /// Coating and medium.
+        coating: Coating,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
+    },
+    /// Dielectric coating over a metal.
+    CoatedConductor {
+        /// Optical constants of the metal (relative to vacuum).
+        spec: ConductorSpec,
+        /// Microfacet roughness of the metal.
+        roughness: Roughness,
+        /// Coating and medium.
+        coating: Coating,
         /// Bump map.
         displacement: Option<FloatTexture>,
     },
@@ -127,6 +193,29 @@ impl Material {
             Material::ThinDielectric { eta, .. } => {
                 Bxdf::ThinDielectric(ThinDielectricBxdf::new(hero_eta(eta, lambda)))
             }
+            Material::CoatedDiffuse {
+                reflectance,
+                coating,
+                ..
+            } => {
+                let r = reflectance.evaluate(&ctx, lambda).clamp(0.0, 1.0);
+                let (top, params) = coating.evaluate(&ctx, lambda);
+                Bxdf::CoatedDiffuse(LayeredBxdf::new(top, DiffuseBxdf::new(r), params))
+            }
+            Material::CoatedConductor {
+                spec,
+                roughness,
+                coating,
+                ..
+            } => {
+                let (eta, k) = conductor_constants(spec, &ctx, lambda);
+                let (top, params) = coating.evaluate(&ctx, lambda);
+                // The metal lies under the coating: its index is relative to the
+                // coating's [pbrt-v4 `CoatedConductorMaterial::GetBxDF`].
+                let base =
+                    ConductorBxdf::new(roughness.distribution(&ctx), eta / top.eta, k / top.eta);
+                Bxdf::CoatedConductor(LayeredBxdf::new(top, base, params))
+            }
             Material::Interface => return None,
             Material::Mix { .. } => {
                 debug_assert!(false, "mix materials are resolved before bsdf()");
@@ -142,7 +231,9 @@ impl Material {
             Material::Diffuse { displacement, .. }
             | Material::Conductor { displacement, .. }
             | Material::Dielectric { displacement, .. }
-            | Material::ThinDielectric { displacement, .. } => displacement.as_ref(),
+            | Material::ThinDielectric { displacement, .. }
+            | Material::CoatedDiffuse { displacement, .. }
+            | Material::CoatedConductor { displacement, .. } => displacement.as_ref(),
             Material::Interface | Material::Mix { .. } => None,
         }
     }

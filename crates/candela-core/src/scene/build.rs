@@ -5,6 +5,7 @@
 //! Everything not supported is an error naming the entity and its
 //! file:line:col; parameters nobody looked at become warnings.
 
+mod coated;
 mod entities;
 mod geometry;
 mod lights;

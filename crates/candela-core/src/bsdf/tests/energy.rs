@@ -10,23 +10,11 @@
 //! deviation measured in the run and b = 1 % for the allowance the brief gives
 //! microfacet models.
 
-use super::{cases, sample, MODES};
+use super::{cases, mean_se, sample, MODES};
 use crate::bsdf::fresnel::{fr_dielectric, ft_dielectric};
 use crate::bsdf::{Bxdf, DielectricBxdf, SampleFlags, TransportMode, TrowbridgeReitz};
 use crate::math::Vec3;
 use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf, Pcg32};
-
-/// Mean and standard error of `n` draws of `w`.
-fn mean_se(n: usize, mut w: impl FnMut() -> f64) -> (f64, f64) {
-    let (mut s, mut sq) = (0.0, 0.0);
-    for _ in 0..n {
-        let x = w();
-        s += x;
-        sq += x * x;
-    }
-    let m = s / n as f64;
-    (m, ((sq / n as f64 - m * m).max(0.0) / n as f64).sqrt())
-}
 
 /// Importance-sampled power albedo at wavelength 0 (see module doc).
 fn energy_albedo(b: &Bxdf, wo: Vec3, mode: TransportMode, n: usize, seed: u64) -> (f64, f64) {

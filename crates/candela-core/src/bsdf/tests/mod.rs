@@ -9,6 +9,7 @@ mod chi2;
 mod consistency;
 mod delta;
 mod energy;
+mod layered;
 
 use super::{
     Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode, TrowbridgeReitz,
@@ -114,6 +115,18 @@ fn eta_of(b: &Bxdf) -> f32 {
         Bxdf::Dielectric(d) => d.eta,
         _ => 1.0,
     }
+}
+
+/// Mean and standard error of `n` draws of `w`.
+fn mean_se(n: usize, mut w: impl FnMut() -> f64) -> (f64, f64) {
+    let (mut s, mut sq) = (0.0, 0.0);
+    for _ in 0..n {
+        let x = w();
+        s += x;
+        sq += x * x;
+    }
+    let m = s / n as f64;
+    (m, ((sq / n as f64 - m * m).max(0.0) / n as f64).sqrt())
 }
 
 /// Samples of `sample_f` with all lobes allowed.

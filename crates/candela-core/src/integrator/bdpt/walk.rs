@@ -183,7 +183,7 @@ fn random_walk(
         } else {
             bs.pdf.0
         };
-        let mut pdf_rev = bsdf.pdf(bs.wi, wo, mode.flip(), SampleFlags::ALL).0;
+        let mut pdf_rev = bsdf.pdf(bs.wi, wo, mode.adjoint(), SampleFlags::ALL).0;
         let n = path.len();
         if bs.is_specular() {
             path[n - 1].delta = true;

@@ -6,12 +6,13 @@
 //! built (anonymous materials first, then named ones in declaration
 //! order), and mixes that contain themselves are rejected.
 
-use super::spectra::{spectrum_param, SpectrumKind};
+use super::coated::{coated_conductor, coated_diffuse, conductor_spec, eta_param};
+use super::spectra::SpectrumKind;
 use super::textures::{Source, Textures};
 use super::BuildError;
 use crate::interaction::MaterialId;
-use crate::material::{ConductorSpec, Material, Roughness};
-use crate::spectrum::{named_spectrum, Spectrum};
+use crate::material::{Material, Roughness};
+use crate::spectrum::Spectrum;
 use crate::texture::{FloatTexture, SpectrumTexture};
 use candela_scene::{MaterialDesc, SceneDescription};
 use std::collections::HashMap;
@@ -66,38 +67,9 @@ fn roughness(src: &Source, tex: &mut Textures) -> Result<Roughness, BuildError> 
     })
 }
 
-/// Index of refraction: a float or a spectrum (pbrt-v4 accepts both).
+/// Index of refraction `eta`: a float or a spectrum (pbrt-v4 accepts both).
 fn eta(src: &Source) -> Result<Spectrum, BuildError> {
-    if let Some(v) = src.params.get_floats("eta")? {
-        return Ok(Spectrum::Constant(v.first().copied().unwrap_or(1.5)));
-    }
-    Ok(
-        spectrum_param(src.params, "eta", SpectrumKind::Unbounded, src.cs)?
-            .unwrap_or(Spectrum::Constant(1.5)),
-    )
-}
-
-/// A built-in spectrum as a constant texture.
-fn builtin(name: &str) -> Result<SpectrumTexture, BuildError> {
-    named_spectrum(name)
-        .map(SpectrumTexture::Constant)
-        .ok_or_else(|| BuildError::Other(format!("missing built-in spectrum {name}")))
-}
-
-/// A conductor's optical constants: `reflectance`, or `eta` and `k` (copper by default).
-fn conductor_spec(src: &Source, tex: &mut Textures) -> Result<ConductorSpec, BuildError> {
-    if let Some(r) = tex.spectrum_opt(src, "reflectance", SpectrumKind::Albedo)? {
-        return Ok(ConductorSpec::Reflectance(r));
-    }
-    let eta = match tex.spectrum_opt(src, "eta", SpectrumKind::Unbounded)? {
-        Some(e) => e,
-        None => builtin("metal-Cu-eta")?,
-    };
-    let k = match tex.spectrum_opt(src, "k", SpectrumKind::Unbounded)? {
-        Some(k) => k,
-        None => builtin("metal-Cu-k")?,
-    };
-    Ok(ConductorSpec::EtaK { eta, k })
+    eta_param(src, "eta")
 }
 
 fn material(
@@ -121,7 +93,7 @@ fn material(
             displacement,
         },
         "conductor" => Material::Conductor {
-            spec: conductor_spec(&src, tex)?,
+            spec: conductor_spec(&src, tex, "eta", "k")?,
             roughness: roughness(&src, tex)?,
             displacement,
         },
@@ -134,9 +106,11 @@ fn material(
             eta: eta(&src)?,
             displacement,
         },
+        "coateddiffuse" => coated_diffuse(&src, tex, displacement)?,
+        "coatedconductor" => coated_conductor(&src, tex, displacement)?,
         "mix" => mix(&src, tex, names)?,
         "interface" | "" | "none" => Material::Interface,
-        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, conductor, dielectric, thindielectric, mix, interface)"))),
+        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, conductor, coateddiffuse, coatedconductor, dielectric, thindielectric, mix, interface)"))),
     })
 }
 
