@@ -29,7 +29,22 @@ enum Cmd {
         a: PathBuf,
         /// The reference.
         b: PathBuf,
+        /// Compare only pixels x0 ≤ x < x1, y0 ≤ y < y1 ("x0,y0,x1,y1").
+        #[arg(long, value_parser = parse_region)]
+        region: Option<[usize; 4]>,
     },
+}
+
+/// Parses "x0,y0,x1,y1".
+fn parse_region(s: &str) -> Result<[usize; 4], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|t| t.trim().parse::<usize>().map_err(|e| format!("{t:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok([x0, y0, x1, y1]),
+        _ => Err("expected x0,y0,x1,y1 with x0 < x1 and y0 < y1".into()),
+    }
 }
 
 #[derive(clap::Args)]
@@ -60,7 +75,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
         Cmd::Render(args) => render(args),
-        Cmd::Diff { a, b } => diff(&a, &b),
+        Cmd::Diff { a, b, region } => diff(&a, &b, region),
     };
     if let Err(e) = result {
         eprintln!("candela: error: {e:#}");
@@ -153,9 +168,16 @@ fn write_outputs(image: &RgbImage, exr: &Path) -> Result<()> {
     Ok(())
 }
 
-fn diff(a: &Path, b: &Path) -> Result<()> {
-    let ia = RgbImage::read_exr(a)?;
-    let ib = RgbImage::read_exr(b)?;
+fn diff(a: &Path, b: &Path, region: Option<[usize; 4]>) -> Result<()> {
+    let (mut ia, mut ib) = (RgbImage::read_exr(a)?, RgbImage::read_exr(b)?);
+    if let Some(r) = region {
+        ia = ia
+            .crop(r)
+            .with_context(|| format!("region outside {}", a.display()))?;
+        ib = ib
+            .crop(r)
+            .with_context(|| format!("region outside {}", b.display()))?;
+    }
     let c = compare(&ia, &ib)?;
     let (ma, mb) = (ia.channel_means(), ib.channel_means());
     println!(

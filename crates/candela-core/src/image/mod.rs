@@ -112,6 +112,21 @@ impl RgbImage {
         })
     }
 
+    /// The pixels x0 ≤ x < x1, y0 ≤ y < y1 of `r = [x0, y0, x1, y1]`; `None` if outside.
+    pub fn crop(&self, r: [usize; 4]) -> Option<RgbImage> {
+        let [x0, y0, x1, y1] = r;
+        if x1 > self.width || y1 > self.height || x0 >= x1 || y0 >= y1 {
+            return None;
+        }
+        let mut out = RgbImage::new(x1 - x0, y1 - y0);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                out.pixels[(y - y0) * out.width + (x - x0)] = self.get(x, y);
+            }
+        }
+        Some(out)
+    }
+
     /// Mean of each channel.
     pub fn channel_means(&self) -> [f64; 3] {
         let mut s = [0.0f64; 3];

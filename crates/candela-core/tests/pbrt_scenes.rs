@@ -1,0 +1,128 @@
+//! Real pbrt-v4 scenes bundled in `scenes/` against pbrt-v4's own renders
+//! beside them (issues #3 and #4):
+//! - killeroo-simple (loopsubdiv, coateddiffuse, sphere area light), path
+//!   tracer: image mean within 3 %.
+//! - caustic-glass (spot light, uniform sky, dielectric and coateddiffuse
+//!   PLY meshes; the reference is pbrt-v4's BDPT): the path tracer within
+//!   3 % in two regions it converges (the lit back floor and the spot's
+//!   pool; it cannot render the caustic), BDPT within 2 % over the whole
+//!   image and within 5 % in the caustic below the glass.
+//! Each bound is the stated relative tolerance plus 5σ of the rendered
+//! mean. Every scene is rendered twice with different seeds; the estimate
+//! is the average of the two and its noise variance per pixel is
+//! (a − b)²/4, so σ² of the region mean is Σ(a − b)²/(4n²): noise only,
+//! without the image's own spatial variation.
+
+use candela_core::image::RgbImage;
+use candela_core::integrator::{NoProgress, RenderContext};
+use candela_core::scene::build::{build, Overrides};
+use std::path::{Path, PathBuf};
+
+fn scene_dir(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+}
+
+fn render(file: &Path, integrator: &str, spp: u32, seed: u64) -> RgbImage {
+    let desc = candela_scene::parse_file(file).expect("scene parses");
+    let ov = Overrides {
+        spp: Some(spp),
+        seed: Some(seed),
+        integrator: Some(integrator.into()),
+        ..Default::default()
+    };
+    let mut setup = build(&desc, &ov).expect("scene builds");
+    let ctx = RenderContext {
+        scene: &setup.scene,
+        camera: &setup.camera,
+        sampler: &setup.sampler,
+        progress: &NoProgress,
+    };
+    setup.integrator.render(&ctx, &mut setup.film);
+    assert_eq!(setup.film.dropped_samples(), 0, "non-finite samples");
+    setup.film.image()
+}
+
+/// Two renders with independent seeds.
+struct Pair(RgbImage, RgbImage);
+
+fn render_pair(file: &Path, integrator: &str, spp: u32) -> Pair {
+    Pair(
+        render(file, integrator, spp, 17),
+        render(file, integrator, spp, 18),
+    )
+}
+
+fn pixels(r: [usize; 4]) -> impl Iterator<Item = (usize, usize)> {
+    (r[1]..r[3]).flat_map(move |y| (r[0]..r[2]).map(move |x| (x, y)))
+}
+
+fn luma(img: &RgbImage, x: usize, y: usize) -> f64 {
+    img.get(x, y).iter().map(|&c| c as f64).sum()
+}
+
+/// Mean of the channel sum of the pair's average over a region, and its noise σ.
+fn region_stats(p: &Pair, r: [usize; 4]) -> (f64, f64) {
+    let n = pixels(r).count() as f64;
+    let (mut sum, mut d2) = (0.0, 0.0);
+    for (x, y) in pixels(r) {
+        let (a, b) = (luma(&p.0, x, y), luma(&p.1, x, y));
+        sum += 0.5 * (a + b);
+        d2 += (a - b) * (a - b) / 4.0;
+    }
+    (sum / n, d2.sqrt() / n)
+}
+
+fn assert_close(img: &Pair, reference: &RgbImage, r: [usize; 4], tol: f64, what: &str) {
+    let (m, se) = region_stats(img, r);
+    let mr = pixels(r).map(|(x, y)| luma(reference, x, y)).sum::<f64>() / pixels(r).count() as f64;
+    eprintln!(
+        "{what}: {m:.5} ± {se:.5} vs pbrt-v4 {mr:.5} (ratio {:.4})",
+        m / mr
+    );
+    assert!(
+        (m - mr).abs() <= tol * mr + 5.0 * se,
+        "{what}: {m} ± {se} vs {mr}"
+    );
+}
+
+#[test]
+fn killeroo_simple_path_tracer_matches_pbrt_v4() {
+    let dir = scene_dir("killeroo-simple");
+    let img = render_pair(&dir.join("killeroo-simple.pbrt"), "path", 4);
+    let reference = RgbImage::read_exr(&dir.join("reference-pbrt-v4-256spp.exr")).expect("ref");
+    assert_close(&img, &reference, [0, 0, 700, 700], 0.03, "killeroo image");
+}
+
+#[test]
+fn caustic_glass_path_tracer_matches_pbrt_v4_away_from_the_caustic() {
+    let dir = scene_dir("caustic-glass");
+    let img = render_pair(&dir.join("scene.pbrt"), "path", 8);
+    let reference =
+        RgbImage::read_exr(&dir.join("reference-pbrt-v4-bdpt-1024spp.exr")).expect("ref");
+    assert_close(
+        &img,
+        &reference,
+        [0, 0, 350, 150],
+        0.03,
+        "back floor and glass top",
+    );
+    assert_close(
+        &img,
+        &reference,
+        [250, 100, 350, 200],
+        0.03,
+        "spot light pool",
+    );
+}
+
+#[test]
+fn caustic_glass_bdpt_matches_pbrt_v4_bdpt() {
+    let dir = scene_dir("caustic-glass");
+    let img = render_pair(&dir.join("scene.pbrt"), "bdpt", 8);
+    let reference =
+        RgbImage::read_exr(&dir.join("reference-pbrt-v4-bdpt-1024spp.exr")).expect("ref");
+    assert_close(&img, &reference, [0, 0, 350, 500], 0.02, "whole image");
+    assert_close(&img, &reference, [120, 200, 260, 330], 0.05, "caustic");
+}
