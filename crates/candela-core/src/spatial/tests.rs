@@ -203,8 +203,9 @@ fn k_zero_and_k_above_n() {
     check_knn(&pts, &qs, 100, f32::INFINITY);
     check_knn(&pts, &qs, 1000, f32::INFINITY);
     check_knn(&pts, &qs, 1000, 0.3);
+    check_knn(&pts, &qs, usize::MAX, f32::INFINITY);
     // Every size around the leaf size and its multiples.
-    for n in 0..40 {
+    for n in 0..100 {
         check_knn(&pts[..n], &qs, 5, f32::INFINITY);
         check_within(&pts[..n], &qs, 0.4);
     }
