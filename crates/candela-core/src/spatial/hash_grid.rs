@@ -120,12 +120,18 @@ impl CellHash {
         (lo.cmple(hi).all()).then_some((lo, hi))
     }
 
+    /// Number of cells in `lo..=hi` (non-empty), saturating.
+    #[inline]
+    fn cell_count(lo: IVec3, hi: IVec3) -> i64 {
+        let ext = hi.as_i64vec3() - lo.as_i64vec3() + 1;
+        ext.x.saturating_mul(ext.y).saturating_mul(ext.z)
+    }
+
     /// Calls `f` once for every distinct bucket of the cells `lo..=hi`
     /// (non-empty); when there are at least as many cells as buckets, for
     /// every bucket.
     pub(super) fn for_each_bucket(&self, lo: IVec3, hi: IVec3, mut f: impl FnMut(usize)) {
-        let ext = hi.as_i64vec3() - lo.as_i64vec3() + 1;
-        let n_cells = ext.x.saturating_mul(ext.y).saturating_mul(ext.z);
+        let n_cells = Self::cell_count(lo, hi);
         if n_cells >= self.n_buckets as i64 {
             (0..self.n_buckets()).for_each(f);
         } else if n_cells as usize <= SMALL_RANGE {
@@ -144,6 +150,16 @@ impl CellHash {
             seen.sort_unstable();
             seen.dedup();
             seen.into_iter().for_each(f);
+        }
+    }
+
+    /// Like [`Self::for_each_bucket`], but a bucket shared by several cells
+    /// of the range comes once per cell, in a row of calls.
+    pub(super) fn for_each_cell_bucket(&self, lo: IVec3, hi: IVec3, f: impl FnMut(usize)) {
+        if Self::cell_count(lo, hi) >= self.n_buckets as i64 {
+            (0..self.n_buckets()).for_each(f);
+        } else {
+            self.for_each_cell(lo, hi, f);
         }
     }
 
