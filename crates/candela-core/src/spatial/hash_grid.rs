@@ -34,6 +34,9 @@ use glam::{IVec3, Vec3};
 /// Relative padding of the query box: a point whose rounded distance² passes
 /// the `≤ r²` test lies within r·(1 + 4ε) of p; this covers that.
 const BOX_PADDING: f32 = 1.0 + 1e-5;
+/// Absolute padding of the query box: offsets below about 1e-19 square to
+/// zero, so such points pass `≤ r²` whatever the radius.
+const BOX_PADDING_ABS: f32 = 1e-18;
 /// Cell ranges up to this many cells de-duplicate buckets on the stack.
 const SMALL_RANGE: usize = 32;
 
@@ -103,13 +106,13 @@ impl CellHash {
     /// the `≤ r²` test passes at any distance, so every cell is in range.
     #[inline]
     pub(super) fn cells_around(&self, p: Vec3, r: f32) -> Option<(IVec3, IVec3)> {
-        if !(r >= 0.0) {
+        if r.is_nan() || r < 0.0 {
             return None;
         }
         if (r * r).is_infinite() {
             return Some((IVec3::MIN, IVec3::MAX));
         }
-        let r = Vec3::splat(r * BOX_PADDING);
+        let r = Vec3::splat(r * BOX_PADDING + BOX_PADDING_ABS);
         Some((self.cell(p - r), self.cell(p + r)))
     }
 

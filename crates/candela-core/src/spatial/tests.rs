@@ -259,6 +259,25 @@ fn huge_and_offset_coordinates() {
 }
 
 #[test]
+fn radius_whose_square_underflows() {
+    // r² and the distances² round to 0, so a point 1e-31 away is "within"
+    // 1e-35; the grid must still look in its cell, across the boundary at 0.
+    let mut pts = random_points(200, 19, Vec3::ZERO, 1.0);
+    pts.push(Vec3::ZERO);
+    let qs = [
+        Vec3::new(-1.0e-31, 0.0, 0.0),
+        Vec3::splat(-1.0e-25),
+        Vec3::ZERO,
+    ];
+    for r in [1.0e-35, 1.0e-20] {
+        check_within(&pts, &qs, r);
+    }
+    let spheres = [(Vec3::new(-1.0e-31, 0.0, 0.0), 1.0e-35), (Vec3::ONE, 0.5)];
+    let grid = SphereGrid::build(&spheres);
+    assert_eq!(check_spheres(&spheres, &grid, &[Vec3::ZERO]), 1);
+}
+
+#[test]
 fn permutation_keeps_every_item_once() {
     let pts = random_points(3_000, 14, Vec3::ZERO, 1.0);
     let tree = PointKdTree::build(items(&pts));
