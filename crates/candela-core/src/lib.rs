@@ -18,5 +18,6 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod spatial;
 pub mod spectrum;
 pub mod texture;
