@@ -7,6 +7,7 @@
 //!   3 % in two regions it converges (the lit back floor and the spot's
 //!   pool; it cannot render the caustic), BDPT within 2 % over the whole
 //!   image and within 5 % in the caustic below the glass.
+//!
 //! Each bound is the stated relative tolerance plus 5σ of the rendered
 //! mean. Every scene is rendered twice with different seeds; the estimate
 //! is the average of the two and its noise variance per pixel is

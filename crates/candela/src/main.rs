@@ -5,6 +5,7 @@ mod progress;
 
 use anyhow::{bail, Context, Result};
 use candela_core::image::{compare, RgbImage};
+use candela_core::integrator::sppm::PpmPartial;
 use candela_core::integrator::RenderContext;
 use candela_core::scene::build::{build, Overrides};
 use clap::{Parser, Subcommand};
@@ -33,6 +34,28 @@ enum Cmd {
         #[arg(long, value_parser = parse_region)]
         region: Option<[usize; 4]>,
     },
+    /// Average partial PPM renders (`--pass-range`) of one scene exactly.
+    Merge {
+        /// The scene the parts were rendered from (for the film settings).
+        scene: PathBuf,
+        /// Partial results (.ppmpart files) with disjoint pass ranges.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output EXR path (a PNG is written beside it).
+        #[arg(long, short)]
+        outfile: PathBuf,
+    },
+}
+
+/// Parses "A..B" (A < B).
+fn parse_range(s: &str) -> Result<(u64, u64), String> {
+    let (a, b) = s.split_once("..").ok_or("expected A..B")?;
+    let a: u64 = a.trim().parse().map_err(|e| format!("{a:?}: {e}"))?;
+    let b: u64 = b.trim().parse().map_err(|e| format!("{b:?}: {e}"))?;
+    if a >= b {
+        return Err(format!("empty pass range {a}..{b}"));
+    }
+    Ok((a, b))
 }
 
 /// Parses "x0,y0,x1,y1".
@@ -51,9 +74,13 @@ fn parse_region(s: &str) -> Result<[usize; 4], String> {
 struct RenderArgs {
     /// Scene file (.pbrt, optionally .gz).
     scene: PathBuf,
-    /// Samples per pixel (overrides the Sampler's "pixelsamples").
+    /// Samples per pixel (overrides the Sampler's "pixelsamples"; SPPM/PPM: iterations).
     #[arg(long)]
     spp: Option<u32>,
+    /// PPM only: render passes A ≤ i < B and also write their sums to
+    /// OUTFILE.ppmpart, for `candela merge`.
+    #[arg(long, value_parser = parse_range)]
+    pass_range: Option<(u64, u64)>,
     /// Integrator name (overrides the Integrator directive).
     #[arg(long)]
     integrator: Option<String>,
@@ -76,6 +103,11 @@ fn main() {
     let result = match cli.cmd {
         Cmd::Render(args) => render(args),
         Cmd::Diff { a, b, region } => diff(&a, &b, region),
+        Cmd::Merge {
+            scene,
+            parts,
+            outfile,
+        } => merge(&scene, &parts, &outfile),
     };
     if let Err(e) = result {
         eprintln!("candela: error: {e:#}");
@@ -100,6 +132,7 @@ fn render(args: RenderArgs) -> Result<()> {
         integrator: args.integrator.clone(),
         outfile: args.outfile.clone(),
         seed: args.seed,
+        pass_range: args.pass_range,
     };
     let mut setup = build(&desc, &ov)?;
     for w in &setup.warnings {
@@ -165,6 +198,46 @@ fn write_outputs(image: &RgbImage, exr: &Path) -> Result<()> {
     }
     image.write_exr(&exr)?;
     image.write_png(&exr.with_extension("png"), 0.0)?;
+    Ok(())
+}
+
+/// Adds partial PPM results and writes their average.
+fn merge(scene: &Path, parts: &[PathBuf], outfile: &Path) -> Result<()> {
+    let mut loaded = parts
+        .iter()
+        .map(|p| PpmPartial::load(p).map_err(anyhow::Error::msg))
+        .collect::<Result<Vec<_>>>()?;
+    loaded.sort_by_key(|p| p.passes.0);
+    let mut total = loaded.remove(0);
+    for p in &loaded {
+        if p.passes.0 != total.passes.1 {
+            bail!(
+                "pass ranges are not contiguous: {}..{} then {}..{}",
+                total.passes.0,
+                total.passes.1,
+                p.passes.0,
+                p.passes.1
+            );
+        }
+        total.merge(p).map_err(anyhow::Error::msg)?;
+    }
+    let desc = candela_scene::parse_file(scene)?;
+    let mut setup = build(&desc, &Overrides::default())?;
+    let (lo, hi) = setup.film.pixel_bounds();
+    if lo != total.origin || hi - lo != total.size {
+        bail!(
+            "the partial results do not match the film of {}",
+            scene.display()
+        );
+    }
+    total.write_film(&mut setup.film);
+    write_outputs(&setup.film.image(), outfile)?;
+    eprintln!(
+        "candela: merged passes {}..{} into {}",
+        total.passes.0,
+        total.passes.1,
+        outfile.display()
+    );
     Ok(())
 }
 

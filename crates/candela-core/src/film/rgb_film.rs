@@ -207,6 +207,22 @@ impl RgbFilm {
         self.dropped_samples += tile.dropped_samples;
     }
 
+    /// Replaces a pixel's value by `rgb` in sensor space (estimators that
+    /// compute final pixel values themselves, like SPPM). Non-finite values
+    /// are dropped and counted.
+    pub fn set_pixel_sensor_rgb(&mut self, pixel: UVec2, rgb: [f64; 3]) {
+        let i = (pixel.y * self.settings.resolution.x + pixel.x) as usize;
+        if rgb.iter().any(|v| !v.is_finite()) {
+            self.dropped_samples += 1;
+            self.pixels[i] = Pixel::default();
+            return;
+        }
+        self.pixels[i] = Pixel {
+            rgb_sum: rgb,
+            weight_sum: 1.0,
+        };
+    }
+
     /// An empty splat buffer for one batch of light paths.
     pub fn splat_buffer(&self) -> SplatBuffer {
         let (lo, hi) = self.settings.pixel_bounds;
@@ -254,8 +270,8 @@ impl RgbFilm {
                 if p.weight_sum != 0.0 {
                     rgb = p.rgb_sum.map(|v| v / p.weight_sum);
                 }
-                for c in 0..3 {
-                    rgb[c] += splat_scale * self.splats[i][c];
+                for (v, s) in rgb.iter_mut().zip(&self.splats[i]) {
+                    *v += splat_scale * s;
                 }
                 let out = self.output_from_sensor
                     * Vec3::new(rgb[0] as f32, rgb[1] as f32, rgb[2] as f32);
@@ -296,8 +312,8 @@ impl FilmTile {
         );
         let w = self.hi.x - self.lo.x;
         let p = &mut self.pixels[((pixel.y - self.lo.y) * w + (pixel.x - self.lo.x)) as usize];
-        for c in 0..3 {
-            p.rgb_sum[c] += (weight * rgb[c]) as f64;
+        for (sum, v) in p.rgb_sum.iter_mut().zip(rgb) {
+            *sum += (weight * v) as f64;
         }
         p.weight_sum += weight as f64;
     }

@@ -10,10 +10,12 @@ pub mod driver;
 mod light_tracer;
 mod path;
 pub mod photon;
+pub mod sppm;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::LightTracer;
 pub use path::{PathIntegrator, PathSettings};
+pub use sppm::{PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings};
 
 use crate::camera::Camera;
 use crate::film::{RgbFilm, SplatBuffer};

@@ -41,6 +41,8 @@ pub struct PhotonHit<'a> {
     pub depth: u32,
     /// Every earlier scattering was specular and there was at least one (an L S+ D path).
     pub caustic: bool,
+    /// A dispersive refraction left only the hero wavelength (already folded into `beta`).
+    pub terminated: bool,
 }
 
 /// How a photon path ended, for power bookkeeping.
@@ -117,6 +119,7 @@ pub fn trace_photon(
                 beta,
                 depth,
                 caustic: caustic && depth > 1,
+                terminated: lam.secondary_terminated(),
             });
         }
         if depth >= settings.max_depth {
@@ -139,7 +142,7 @@ pub fn trace_photon(
         caustic &= bs.is_specular();
         // Russian roulette keeps |β| roughly constant [pbrt-v4 SPPM photon pass].
         let survive = (new_beta.max_component() / beta.max_component()).min(1.0);
-        if !(survive > 0.0) || rng.u1() >= survive {
+        if survive.is_nan() || survive <= 0.0 || rng.u1() >= survive {
             fate.absorbed = beta;
             break;
         }

@@ -73,6 +73,8 @@ pub struct Overrides {
     pub outfile: Option<PathBuf>,
     /// `--seed`.
     pub seed: Option<u64>,
+    /// `--pass-range A..B` (PPM: render passes A ≤ i < B).
+    pub pass_range: Option<(u64, u64)>,
 }
 
 /// Everything needed to render.

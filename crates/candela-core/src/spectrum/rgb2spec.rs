@@ -153,8 +153,8 @@ fn gauss_newton(mut c: [f64; 3], target: [f64; 3], w: &[[f64; 3]]) -> [f64; 3] {
             }
             g[p] = -(0..3).map(|i| j[i][p] * r[i]).sum::<f64>();
         }
-        for p in 0..3 {
-            a[p][p] *= 1.0 + lambda_damp;
+        for (p, row) in a.iter_mut().enumerate() {
+            row[p] *= 1.0 + lambda_damp;
         }
         let Some(d) = solve3(a, g) else { break };
         let cn = [c[0] + d[0], c[1] + d[1], c[2] + d[2]];

@@ -1,5 +1,6 @@
 //! Shared helpers for the integration tests: render a scene given as text
-//! and measure image statistics.
+//! and measure image statistics. Each test binary uses a subset of them.
+#![allow(dead_code)]
 
 use candela_core::image::RgbImage;
 use candela_core::integrator::{NoProgress, RenderContext};

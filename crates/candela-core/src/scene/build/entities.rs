@@ -5,7 +5,8 @@ use crate::camera::{Camera, CameraParams};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{FilmSettings, RgbFilm};
 use crate::integrator::{
-    BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings, Visualize,
+    BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings,
+    PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, Visualize,
 };
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
@@ -289,13 +290,52 @@ pub fn integrator(
             };
             return Ok((Box::new(BdptIntegrator { settings }), name, power));
         }
+        "sppm" | "ppm" => {
+            let seed = match (ov.seed, &desc.sampler) {
+                (Some(s), _) => s,
+                (None, _) => p.get_int("seed", 0)? as u64,
+            };
+            let photons = p.get_int("photonsperiteration", -1)? as i64;
+            let radius = p.get_float("radius", 1.0)?;
+            if radius.is_nan() || radius <= 0.0 {
+                return Err(BuildError::at(
+                    p.param_loc("radius").unwrap_or(&e.loc),
+                    format!("\"radius\" must be positive, found {radius}"),
+                ));
+            }
+            // Photons are shot by power, as pbrt-v4's SPPM does.
+            if name == "sppm" {
+                if ov.pass_range.is_some() {
+                    return Err(BuildError::Other(
+                        "--pass-range needs Integrator \"ppm\" (SPPM passes are not independent)".into(),
+                    ));
+                }
+                let settings = SppmSettings {
+                    photons_per_iteration: photons,
+                    radius,
+                    max_depth,
+                    seed,
+                };
+                return Ok((Box::new(SppmIntegrator { settings }), name, true));
+            }
+            let partial_out = ov.pass_range.map(|_| outfile.with_extension("ppmpart"));
+            let settings = PpmSettings {
+                photons_per_pass: photons,
+                radius,
+                max_depth,
+                seed,
+                pass_range: ov.pass_range,
+                partial_out,
+            };
+            return Ok((Box::new(PpmIntegrator { settings }), name, true));
+        }
         "path" => {}
         "volpath" => warnings.push(format!(
             "{}: integrator \"volpath\" rendered with \"path\" (participating media are not supported yet; identical without media)",
             e.loc
         )),
         other => {
-            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath, bdpt)")));
+            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath, bdpt, sppm, ppm)")));
         }
     }
     let settings = PathSettings {
