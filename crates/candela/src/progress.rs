@@ -27,7 +27,7 @@ impl Progress for Bar {
     fn start(&self, total: u64, unit: &str) {
         self.bar.set_length(total);
         let style = ProgressStyle::with_template(&format!(
-            "{{elapsed_precise}} [{{bar:40}}] {{percent:>3}}% {{pos}}/{{len}} {unit} ETA {{eta}}"
+            "{{elapsed_precise}} [{{bar:40}}] {{percent:>3}}% {{pos}}/{{len}} {unit} ETA {{eta}} {{msg}}"
         ))
         .unwrap_or_else(|_| ProgressStyle::default_bar());
         self.bar.set_style(style);
@@ -37,5 +37,8 @@ impl Progress for Bar {
     }
     fn finish(&self) {
         self.bar.finish_and_clear();
+    }
+    fn message(&self, msg: &str) {
+        self.bar.set_message(msg.to_string());
     }
 }

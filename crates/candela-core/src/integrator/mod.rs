@@ -32,6 +32,8 @@ pub trait Progress: Sync {
     fn advance(&self, done: u64);
     /// Called once at the end.
     fn finish(&self);
+    /// Status shown beside the bar (photon rates, radius).
+    fn message(&self, _msg: &str) {}
 }
 
 /// A progress sink that ignores everything.

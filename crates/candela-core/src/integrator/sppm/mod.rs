@@ -125,6 +125,7 @@ impl Integrator for SppmIntegrator {
             pixels.len()
         ];
         ctx.progress.start(iterations as u64, "iterations");
+        let t0 = std::time::Instant::now();
         for iter in 0..iterations {
             let lambda = pass_wavelengths(st.seed, iter as u64);
             let visits = camera_pass(ctx, film, &pixels, iter, &lambda, st.max_depth);
@@ -150,6 +151,12 @@ impl Integrator for SppmIntegrator {
                 *s = sppm_update(s, g.m as f64, phi.map(|v| v as f64), ALPHA);
             }
             ctx.progress.advance(1);
+            let mean_r = stats.iter().map(|s| s.r2.sqrt()).sum::<f64>() / stats.len().max(1) as f64;
+            let rate = (iter as f64 + 1.0) * n_photons as f64 / t0.elapsed().as_secs_f64();
+            ctx.progress.message(&format!(
+                "{:.2} M photons/s, mean radius {mean_r:.4}",
+                rate / 1e6
+            ));
         }
         let np = iterations as f64 * n_photons as f64;
         for (p, s) in pixels.iter().zip(&stats) {

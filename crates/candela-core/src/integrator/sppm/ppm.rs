@@ -175,6 +175,7 @@ impl PpmIntegrator {
         };
         let mut sums = vec![[0i128; 3]; pixels.len()];
         ctx.progress.start(end.saturating_sub(begin), "passes");
+        let t0 = std::time::Instant::now();
         for pass in begin..end {
             let lambda = pass_wavelengths(st.seed, pass);
             let visits = camera_pass(ctx, film, &pixels, pass as u32, &lambda, st.max_depth);
@@ -197,6 +198,12 @@ impl PpmIntegrator {
                 }
             }
             ctx.progress.advance(1);
+            let rate = (pass - begin + 1) as f64 * n_photons as f64 / t0.elapsed().as_secs_f64();
+            ctx.progress.message(&format!(
+                "{:.2} M photons/s, radius {:.4}",
+                rate / 1e6,
+                r2.sqrt()
+            ));
         }
         ctx.progress.finish();
         PpmPartial {
