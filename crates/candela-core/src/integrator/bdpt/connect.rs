@@ -13,7 +13,7 @@
 //! f̂_L = f·|ωo·ns||ωi·ng|/|ωo·ng| is the light-side BSDF with the adjoint
 //! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
 
-use super::mis::{mis_weight, MisHeuristic, PathView};
+use super::mis::{mis_weight, MisHeuristic, PathDensities, PathView};
 use super::vertex::{emitted, pdf_light_origin, Vertex, VertexKind};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
@@ -23,6 +23,7 @@ use crate::math::{Vec2, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use std::cell::RefCell;
 
 /// One strategy's result.
 #[derive(Clone, Copy, Debug)]
@@ -45,6 +46,15 @@ pub(crate) struct ConnectCtx<'a> {
     pub lambda: &'a SampledWavelengths,
     /// MIS heuristic.
     pub heuristic: MisHeuristic,
+    /// Reused density buffers of the MIS weights.
+    pub scratch: RefCell<PathDensities>,
+}
+
+impl ConnectCtx<'_> {
+    fn weight(&self, view: &PathView<'_>) -> f32 {
+        let mut scratch = self.scratch.borrow_mut();
+        mis_weight(self.scene, self.camera, view, self.heuristic, &mut scratch)
+    }
 }
 
 /// Evaluates strategy (s, t); `None` when it contributes nothing.
@@ -60,7 +70,7 @@ pub(crate) fn connect(
         return connect_emitter(cx, cam, t);
     }
     let (c, view) = strategy(cx, light, cam, s, t, sampler)?;
-    let w = mis_weight(cx.scene, cx.camera, &view, cx.heuristic);
+    let w = cx.weight(&view);
     Some(Contribution {
         unweighted: c.0,
         weighted: c.0 * w,
@@ -116,7 +126,7 @@ fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Cont
             cam_end: Some(e),
         };
         out.unweighted += c;
-        out.weighted += c * mis_weight(cx.scene, cx.camera, &view, cx.heuristic);
+        out.weighted += c * cx.weight(&view);
     };
     if v.at_infinity() {
         for &id in cx.scene.infinite_lights() {

@@ -84,6 +84,7 @@ impl PathView<'_> {
 }
 
 /// p_L and p_E of one path: stored densities plus the ones the connection creates.
+#[derive(Default)]
 pub(crate) struct PathDensities {
     /// p_L[i].
     pub p_light: Vec<f32>,
@@ -96,11 +97,24 @@ pub(crate) struct PathDensities {
 impl PathDensities {
     /// Gathers the densities of `view`, computing the four (at s = 0: three
     /// plus the emitter's origin density) that depend on the connection.
+    #[cfg(test)]
     pub fn of(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
+        let mut d = Self::default();
+        d.fill(scene, camera, view);
+        d
+    }
+
+    /// Refills `self` for `view`, reusing its buffers.
+    pub fn fill(&mut self, scene: &Scene, camera: &Camera, view: &PathView<'_>) {
         let (n, s) = (view.n(), view.s);
-        let mut p_light = Vec::with_capacity(n);
-        let mut p_eye = Vec::with_capacity(n);
-        let mut delta = Vec::with_capacity(n);
+        let Self {
+            p_light,
+            p_eye,
+            delta,
+        } = self;
+        p_light.clear();
+        p_eye.clear();
+        delta.clear();
         for i in 0..n {
             let v = view.get(i);
             if i < s {
@@ -128,11 +142,6 @@ impl PathDensities {
         }
         if s >= 2 {
             p_eye[s - 2] = pdf(scene, camera, x(s - 1), Some(x(s)), x(s - 2), rad);
-        }
-        Self {
-            p_light,
-            p_eye,
-            delta,
         }
     }
 }
@@ -202,13 +211,14 @@ pub(crate) fn weight_from_densities(
     1.0 / sum
 }
 
-/// MIS weight of the strategy that made `view`.
+/// MIS weight of the strategy that made `view`; `scratch` is reused storage.
 pub(crate) fn mis_weight(
     scene: &Scene,
     camera: &Camera,
     view: &PathView<'_>,
     h: MisHeuristic,
+    scratch: &mut PathDensities,
 ) -> f32 {
-    let d = PathDensities::of(scene, camera, view);
-    weight_from_densities(scene, camera, view.get(0), &d, view.s, h)
+    scratch.fill(scene, camera, view);
+    weight_from_densities(scene, camera, view.get(0), scratch, view.s, h)
 }

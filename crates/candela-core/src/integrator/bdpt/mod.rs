@@ -133,6 +133,7 @@ impl BdptIntegrator {
             camera: ctx.camera,
             lambda: &lambda,
             heuristic: self.settings.heuristic,
+            scratch: Default::default(),
         };
         for t in 1..=cam.len() {
             for s in 0..=light.len() {

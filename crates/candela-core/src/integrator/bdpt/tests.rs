@@ -270,6 +270,7 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
             camera: &rs.camera,
             lambda: &lambda,
             heuristic: h,
+            scratch: Default::default(),
         };
         for t in 1..=cam.len() {
             for s in 0..=light.len() {
