@@ -294,3 +294,19 @@ fn t7_each_bdpt_strategy_alone_renders_the_emitter_radiance() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn t4d_lossless_diffuse_transmitter_vanishes_under_uniform_sky() {
+    // validation.md T4(d): a closed object whose BSDF loses no energy
+    // (diffusetransmission with R + T = 1) renders the sky, 1, everywhere;
+    // through the path tracer and BDPT (importance-mode transmission).
+    let scene = env_scene(false).replace(
+        "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]",
+        "Material \"diffusetransmission\" \"rgb reflectance\" [0.3 0.3 0.3] \"rgb transmittance\" [0.7 0.7 0.7]",
+    );
+    assert!(scene.contains("diffusetransmission"));
+    let img = render_str(&scene, &ov(512));
+    assert_region(&img, (10, 22, 10, 22), 1.0, 2e-3, "T4d transmitter, PT");
+    let img = render_str(&scene, &bdpt(128));
+    assert_region(&img, (10, 22, 10, 22), 1.0, 2e-3, "T4d transmitter, BDPT");
+}

@@ -10,6 +10,7 @@
 mod conductor;
 mod dielectric;
 mod diffuse;
+mod diffuse_transmission;
 pub mod fresnel;
 pub mod layered;
 pub mod microfacet;
@@ -21,6 +22,7 @@ mod tests;
 pub use conductor::ConductorBxdf;
 pub use dielectric::DielectricBxdf;
 pub use diffuse::DiffuseBxdf;
+pub use diffuse_transmission::DiffuseTransmissionBxdf;
 pub use layered::{CoatedConductorBxdf, CoatedDiffuseBxdf, LayerParams, LayeredBxdf};
 pub use microfacet::TrowbridgeReitz;
 pub use thin_dielectric::ThinDielectricBxdf;
@@ -159,6 +161,8 @@ impl BsdfSample {
 pub enum Bxdf {
     /// Lambertian reflection.
     Diffuse(DiffuseBxdf),
+    /// Lambertian reflection and transmission.
+    DiffuseTransmission(DiffuseTransmissionBxdf),
     /// Metal: mirror or Torrance–Sparrow reflection.
     Conductor(ConductorBxdf),
     /// Dielectric interface: smooth or rough reflection and refraction.
@@ -176,6 +180,7 @@ macro_rules! dispatch_bxdf {
     ($self:expr, $b:ident => $e:expr) => {
         match $self {
             Bxdf::Diffuse($b) => $e,
+            Bxdf::DiffuseTransmission($b) => $e,
             Bxdf::Conductor($b) => $e,
             Bxdf::Dielectric($b) => $e,
             Bxdf::ThinDielectric($b) => $e,
@@ -237,6 +242,12 @@ impl Bxdf {
             }
         }
         sum / uc.len().max(1) as f32
+    }
+}
+
+impl From<DiffuseTransmissionBxdf> for Bxdf {
+    fn from(b: DiffuseTransmissionBxdf) -> Self {
+        Self::DiffuseTransmission(b)
     }
 }
 

@@ -19,8 +19,8 @@ pub use bump::{apply_bump, bump_map};
 pub use mix::mix_choice;
 
 use crate::bsdf::{
-    Bsdf, Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, LayerParams, LayeredBxdf,
-    ThinDielectricBxdf, TrowbridgeReitz,
+    Bsdf, Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, DiffuseTransmissionBxdf, LayerParams,
+    LayeredBxdf, ThinDielectricBxdf, TrowbridgeReitz,
 };
 use crate::interaction::{MaterialId, SurfaceInteraction};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
@@ -140,6 +140,17 @@ pub enum Material {
         /// Bump map.
         displacement: Option<FloatTexture>,
     },
+    /// Lambertian reflection and transmission.
+    DiffuseTransmission {
+        /// Reflectance (scaled by `scale`).
+        reflectance: SpectrumTexture,
+        /// Transmittance (scaled by `scale`).
+        transmittance: SpectrumTexture,
+        /// Factor on both.
+        scale: f32,
+        /// Bump map.
+        displacement: Option<FloatTexture>,
+    },
     /// Dielectric coating over a Lambertian base.
     CoatedDiffuse {
         /// Albedo of the base.
@@ -193,6 +204,15 @@ impl Material {
             Material::ThinDielectric { eta, .. } => {
                 Bxdf::ThinDielectric(ThinDielectricBxdf::new(hero_eta(eta, lambda)))
             }
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+                scale,
+                ..
+            } => Bxdf::DiffuseTransmission(DiffuseTransmissionBxdf::new(
+                (reflectance.evaluate(&ctx, lambda) * *scale).clamp(0.0, 1.0),
+                (transmittance.evaluate(&ctx, lambda) * *scale).clamp(0.0, 1.0),
+            )),
             Material::CoatedDiffuse {
                 reflectance,
                 coating,
@@ -232,6 +252,7 @@ impl Material {
             | Material::Conductor { displacement, .. }
             | Material::Dielectric { displacement, .. }
             | Material::ThinDielectric { displacement, .. }
+            | Material::DiffuseTransmission { displacement, .. }
             | Material::CoatedDiffuse { displacement, .. }
             | Material::CoatedConductor { displacement, .. } => displacement.as_ref(),
             Material::Interface | Material::Mix { .. } => None,

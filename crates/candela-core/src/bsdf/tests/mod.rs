@@ -12,7 +12,8 @@ mod energy;
 mod layered;
 
 use super::{
-    Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode, TrowbridgeReitz,
+    Bxdf, ConductorBxdf, DielectricBxdf, DiffuseBxdf, DiffuseTransmissionBxdf, SampleFlags,
+    TransportMode, TrowbridgeReitz,
 };
 use crate::math::{spherical_direction, Vec2, Vec3};
 use crate::sampling::Pcg32;
@@ -62,6 +63,15 @@ fn cases() -> Vec<Case> {
         bxdf: DiffuseBxdf::new(SampledSpectrum([0.2, 0.5, 0.8, 1.0])).into(),
         wos: wos_above(),
     }];
+    out.push(Case {
+        name: "diffuse transmission".into(),
+        bxdf: DiffuseTransmissionBxdf::new(
+            SampledSpectrum([0.2, 0.5, 0.3, 0.6]),
+            SampledSpectrum([0.7, 0.1, 0.3, 0.4]),
+        )
+        .into(),
+        wos: wos_both(),
+    });
     let (eta, k) = gold();
     for (ax, ay) in [(0.05, 0.05), (0.3, 0.3), (0.1, 0.4)] {
         out.push(Case {

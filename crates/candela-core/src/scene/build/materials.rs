@@ -106,11 +106,17 @@ fn material(
             eta: eta(&src)?,
             displacement,
         },
+        "diffusetransmission" => Material::DiffuseTransmission {
+            reflectance: tex.spectrum(&src, "reflectance", SpectrumKind::Albedo, 0.25)?,
+            transmittance: tex.spectrum(&src, "transmittance", SpectrumKind::Albedo, 0.25)?,
+            scale: src.params.get_float("scale", 1.0)?,
+            displacement,
+        },
         "coateddiffuse" => coated_diffuse(&src, tex, displacement)?,
         "coatedconductor" => coated_conductor(&src, tex, displacement)?,
         "mix" => mix(&src, tex, names)?,
         "interface" | "" | "none" => Material::Interface,
-        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, conductor, coateddiffuse, coatedconductor, dielectric, thindielectric, mix, interface)"))),
+        other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, diffusetransmission, conductor, coateddiffuse, coatedconductor, dielectric, thindielectric, mix, interface)"))),
     })
 }
 
