@@ -69,6 +69,10 @@ impl Scene {
     pub fn primitive_count(&self) -> usize {
         self.primitives.len()
     }
+    /// All primitives.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.primitives
+    }
     /// All lights.
     pub fn lights(&self) -> &[Light] {
         &self.lights
