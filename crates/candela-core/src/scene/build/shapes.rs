@@ -19,7 +19,7 @@ use crate::shape::{
     loop_subdivide, BilinearPatch, BilinearPatchMesh, Cylinder, Disk, Shape, Sphere, Triangle,
     TriangleMesh,
 };
-use candela_scene::{ParamSet, ShapeDesc};
+use candela_scene::{ParamSet, SceneError, ShapeDesc};
 use std::sync::Arc;
 
 /// The shapes one `Shape` directive creates, placed by `t`.
@@ -189,7 +189,15 @@ fn plymesh(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
             "plymesh \"displacement\" is not supported yet",
         ));
     }
-    let m = candela_scene::read_ply(&file).map_err(|e| BuildError::at(&s.loc, format!("{e}")))?;
+    // A missing file is reported at the "filename" parameter; a malformed
+    // one at the directive, followed by the place in the PLY file.
+    let m = candela_scene::read_ply(&file).map_err(|e| match e {
+        SceneError::Io { path, error, .. } => {
+            let at = p.param_loc("filename").unwrap_or(&s.loc);
+            BuildError::Scene(SceneError::io(at, &path, error))
+        }
+        other => BuildError::at(&s.loc, format!("bad PLY file: {other}")),
+    })?;
     let input = MeshInput {
         p: m.positions,
         indices: m.indices.iter().map(|&i| i as i32).collect(),
