@@ -167,10 +167,16 @@ fn triangles(s: &ShapeDesc, t: &Transform, m: MeshInput) -> Result<Vec<Shape>, B
         m.face,
     )
     .map_err(|e| BuildError::at(&s.loc, format!("invalid triangle mesh: {e}")))?;
-    Ok(Triangle::all(&Arc::new(mesh))
-        .into_iter()
-        .map(Shape::Triangle)
-        .collect())
+    Ok(triangle_shapes(mesh))
+}
+
+/// One shape per triangle of `mesh` (collected straight into shapes: a
+/// million-triangle mesh would otherwise be copied through a `Vec<Triangle>`).
+fn triangle_shapes(mesh: TriangleMesh) -> Vec<Shape> {
+    let mesh = Arc::new(mesh);
+    (0..mesh.triangle_count() as u32)
+        .map(|i| Shape::Triangle(Triangle::new(mesh.clone(), i)))
+        .collect()
 }
 
 fn trianglemesh(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
@@ -268,8 +274,5 @@ fn loopsubdiv(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
         None,
     )
     .map_err(|e| BuildError::at(&s.loc, format!("invalid subdivided mesh: {e}")))?;
-    Ok(Triangle::all(&Arc::new(mesh))
-        .into_iter()
-        .map(Shape::Triangle)
-        .collect())
+    Ok(triangle_shapes(mesh))
 }
