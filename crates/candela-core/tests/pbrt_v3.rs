@@ -47,7 +47,7 @@ fn matte_is_diffuse() {
         "Material \"matte\" \"rgb Kd\" [0.2 0.4 0.6] \"float sigma\" [0]\nShape \"sphere\"",
         "Material \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\nShape \"sphere\"",
         &[
-            "material \"matte\" upgraded to \"diffuse\"",
+            "Material \"matte\" upgraded to \"diffuse\"",
             "\"Kd\" → \"reflectance\"",
         ],
     );
@@ -176,9 +176,9 @@ fn mix_reverses_its_named_materials_and_bumpmap_is_displacement() {
     assert_eq!(built(&a), built(&b));
     assert!(b.warnings.is_empty(), "{:?}", b.warnings);
     assert_eq!(a.warnings.len(), 2, "{:#?}", a.warnings);
-    assert!(a.warnings[0].starts_with("v3.pbrt:5:1: material \"matte\" upgraded to \"diffuse\""));
+    assert!(a.warnings[0].starts_with("v3.pbrt:5:1: Material \"matte\" upgraded to \"diffuse\""));
     assert!(a.warnings[0].contains("\"bumpmap\" → \"displacement\""));
-    assert!(a.warnings[1].starts_with("v3.pbrt:7:1: material \"mix\" upgraded"));
+    assert!(a.warnings[1].starts_with("v3.pbrt:7:1: Material \"mix\" upgraded"));
     assert!(
         a.warnings[1].contains("→ \"materials\" [\"b\" \"a\"]"),
         "{}",

@@ -30,6 +30,9 @@ fn options_block_entities() {
     let d = parse("Sampler \"lowdiscrepancy\" \"integer pixelsamples\" [4]");
     assert_eq!(d.sampler.as_ref().unwrap().name, "paddedsobol");
     one_warning(&d, 1);
+    let d = parse("Sampler \"random\"");
+    assert_eq!(d.sampler.as_ref().unwrap().name, "independent");
+    one_warning(&d, 1);
 
     let d = parse(
         "\nIntegrator \"directlighting\" \"integer maxdepth\" [5] \"float rrthreshold\" [0.1]",

@@ -84,7 +84,7 @@ pub(crate) fn material(
     .to_string();
     let renamed = new != old;
     *ty = new;
-    Ok(e.finish(headline("material", &old, ty), renamed))
+    Ok(e.finish(headline("Material", &old, ty), renamed))
 }
 
 /// `plastic`/`uber`: `coateddiffuse`, or `diffuse` when the specular colour

@@ -179,6 +179,9 @@ pub(crate) fn option_entity(
             rename_entity(name, "paddedsobol")
         }
         (OptionEntity::Sampler, "maxmindist") => rename_entity(name, "pmj02bn"),
+        // pbrt-v3's "random" is pbrt-v4's "independent" (pbrt-v4's upgrade
+        // leaves the name, which pbrt-v4 then rejects).
+        (OptionEntity::Sampler, "random") => rename_entity(name, "independent"),
         (OptionEntity::Integrator, _) => integrator(&mut e, name),
         (OptionEntity::PixelFilter, _) => {
             e.rename("xwidth", "xradius");
