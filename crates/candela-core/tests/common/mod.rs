@@ -1,6 +1,11 @@
 //! Shared helpers for the integration tests: render a scene given as text
 //! and measure image statistics.
 
+// Every test binary compiles its own copy of this module and uses a subset.
+#![allow(dead_code)]
+
+pub mod stats;
+
 use candela_core::image::RgbImage;
 use candela_core::integrator::{NoProgress, RenderContext};
 use candela_core::scene::build::{build, Overrides};
