@@ -11,11 +11,10 @@ mod common;
 
 use candela_core::image::RgbImage;
 use candela_core::scene::build::Overrides;
-use common::render_str;
+use common::{render_str, stats};
 
 const K: usize = 8;
 const RES: usize = 32;
-const BLOCK: usize = 8;
 
 fn cornell_small() -> String {
     let text = std::fs::read_to_string(concat!(
@@ -49,113 +48,37 @@ Shape "sphere" "float radius" [1]
     .to_string()
 }
 
-/// Block means (luminance-like sum of channels) of K renders.
+/// Block means of K renders, `[block][render]`.
 fn block_means(scene: &str, integrator: &str, spp: u32) -> Vec<Vec<f64>> {
     assert!(scene.contains("[32]"), "resolution override did not apply");
-    let nb = RES / BLOCK;
-    let mut out = vec![Vec::with_capacity(K); nb * nb];
-    for k in 0..K {
-        let ov = Overrides {
-            spp: Some(spp),
-            seed: Some(100 + k as u64),
-            integrator: Some(integrator.into()),
-            ..Default::default()
-        };
-        let img: RgbImage = render_str(scene, &ov);
-        for by in 0..nb {
-            for bx in 0..nb {
-                let mut s = 0.0f64;
-                for y in by * BLOCK..(by + 1) * BLOCK {
-                    for x in bx * BLOCK..(bx + 1) * BLOCK {
-                        let p = img.get(x, y);
-                        s += (p[0] + p[1] + p[2]) as f64;
-                    }
-                }
-                out[by * nb + bx].push(s / (BLOCK * BLOCK) as f64);
-            }
-        }
-    }
-    out
-}
-
-fn mean_var(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    (
-        m,
-        v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0),
-    )
-}
-
-/// Regularised incomplete beta I_x(a, b) by Lentz's continued fraction.
-fn inc_beta(a: f64, b: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    if x > (a + 1.0) / (a + b + 2.0) {
-        return 1.0 - inc_beta(b, a, 1.0 - x);
-    }
-    let ln_front =
-        a * x.ln() + b * (1.0 - x).ln() - (ln_gamma(a) + ln_gamma(b) - ln_gamma(a + b)) - a.ln();
-    let (tiny, mut f, mut c, mut d) = (1e-300, 1.0, 1.0, 0.0);
-    for i in 0..400 {
-        let m = (i / 2) as f64;
-        let num = if i == 0 {
-            1.0
-        } else if i % 2 == 0 {
-            m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m))
-        } else {
-            -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
-        };
-        d = 1.0 + num * d;
-        d = if d.abs() < tiny { tiny } else { d };
-        d = 1.0 / d;
-        c = 1.0 + num / c;
-        c = if c.abs() < tiny { tiny } else { c };
-        let cd = c * d;
-        f *= cd;
-        if (cd - 1.0).abs() < 1e-14 {
-            break;
-        }
-    }
-    ln_front.exp() * (f - 1.0)
-}
-
-fn ln_gamma(x: f64) -> f64 {
-    candela_core::sampling::chi2::ln_gamma(x)
-}
-
-/// Two-sided p-value of Student's t with `df` degrees of freedom.
-fn t_two_sided_p(t: f64, df: f64) -> f64 {
-    inc_beta(df / 2.0, 0.5, df / (df + t * t))
+    let renders: Vec<Vec<f64>> = (0..K)
+        .map(|k| {
+            let ov = Overrides {
+                spp: Some(spp),
+                seed: Some(100 + k as u64),
+                integrator: Some(integrator.into()),
+                ..Default::default()
+            };
+            let img: RgbImage = render_str(scene, &ov);
+            assert_eq!((img.width, img.height), (RES, RES));
+            stats::block_means(&img)
+        })
+        .collect();
+    stats::by_block(&renders)
 }
 
 #[test]
 fn student_t_p_values_match_tables() {
     // Two-sided critical values: t(10) = 2.228 at 0.05, t(5) = 4.032 at 0.01, t(30) = 2.750 at 0.01.
     for (t, df, p) in [(2.228, 10.0, 0.05), (4.032, 5.0, 0.01), (2.750, 30.0, 0.01)] {
-        let got = t_two_sided_p(t, df);
+        let got = stats::t_two_sided_p(t, df);
         assert!((got - p).abs() < 2e-4, "t={t} df={df}: {got}");
     }
 }
 
-/// Welch's t-test per block between two integrators' K renders; fails on
-/// any block below the Šidák-corrected level for α = 0.01 overall.
+/// Welch's t-test per block between two integrators' K renders.
 fn assert_agree(a: &[Vec<f64>], b: &[Vec<f64>], what: &str) {
-    let m = a.len();
-    let alpha = 1.0 - (1.0f64 - 0.01).powf(1.0 / m as f64);
-    for blk in 0..m {
-        let ((mx, vx), (my, vy)) = (mean_var(&a[blk]), mean_var(&b[blk]));
-        let (sx, sy) = (vx / K as f64, vy / K as f64);
-        let t = (mx - my) / (sx + sy).sqrt();
-        // Welch–Satterthwaite degrees of freedom.
-        let df = (sx + sy).powi(2) / (sx * sx / (K as f64 - 1.0) + sy * sy / (K as f64 - 1.0));
-        let p = t_two_sided_p(t.abs(), df);
-        assert!(p >= alpha, "{what}, block {blk}: {mx:.5} vs {my:.5}, t = {t:.2}, df = {df:.1}, p = {p:.2e} < {alpha:.2e}");
-    }
+    stats::assert_blocks_agree(a, b, what);
 }
 
 #[test]

@@ -258,3 +258,38 @@ Shape "loopsubdiv" "integer levels" [2] "point3 P" [1 0 0 -1 0 0 0 1 0 0 -1 0 0 
     let img = render_str(&scene, &ov(16));
     assert_region(&img, (0, 32, 0, 32), 2.0, 2e-3 * 2.0, "loopsubdiv emitter");
 }
+
+#[test]
+fn plymesh_file_errors_name_the_parameter_or_the_place_in_the_file() {
+    let d = std::env::temp_dir().join(format!("candela-shapes-ply-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let missing = d.join("missing.ply");
+    let world = format!(
+        "Material \"diffuse\"\nShape \"plymesh\"  \"string filename\" \"{}\"\n",
+        missing.display()
+    );
+    let e = setup(&world).err().expect("missing file").to_string();
+    // Line 8 (after the 5-line header, WorldBegin and Material), at the parameter.
+    assert!(
+        e.starts_with(&format!(
+            "shapes.pbrt:8:18: cannot read '{}': ",
+            missing.display()
+        )),
+        "{e}"
+    );
+    let bad = d.join("bad.ply");
+    std::fs::write(&bad, "ply\nformat ascii 1.0\nelement vertex 3\nbogus\n").unwrap();
+    let world = format!(
+        "Shape \"plymesh\" \"string filename\" \"{}\"\n",
+        bad.display()
+    );
+    let e = setup(&world).err().expect("malformed file").to_string();
+    assert!(
+        e.starts_with(&format!(
+            "shapes.pbrt:7:1: bad PLY file: {}:4:1: ",
+            bad.display()
+        )),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&d).ok();
+}

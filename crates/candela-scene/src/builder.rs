@@ -251,6 +251,10 @@ impl Builder {
         loc: &Loc,
     ) -> Result<()> {
         self.require_options(&format!("{which:?}"), loc)?;
+        let (mut name, mut params) = (name, params);
+        if let Some(w) = crate::upgrade::option_entity(which, &mut name, &mut params, loc) {
+            self.warn(loc, w);
+        }
         let e = Some(self.entity(name, params, loc));
         match which {
             OptionEntity::Film => self.desc.film = e,

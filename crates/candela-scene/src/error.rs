@@ -66,15 +66,17 @@ pub enum SceneError {
         message: String,
     },
     /// A file (scene, Include, spectrum, mesh) could not be read.
-    #[error("{loc}: cannot read '{}': {source}", path.display())]
+    ///
+    /// The message already ends with the I/O error, so it is not also
+    /// chained as a `source()` (error reporters would print it twice).
+    #[error("{loc}: cannot read '{}': {error}", path.display())]
     Io {
-        /// The directive that asked for the file, or the file itself.
+        /// The directive or parameter that asked for the file, or the file itself.
         loc: Loc,
         /// The path that failed.
         path: PathBuf,
         /// The underlying error.
-        #[source]
-        source: io::Error,
+        error: io::Error,
     },
 }
 
@@ -96,11 +98,11 @@ impl SceneError {
     }
 
     /// An I/O error on `path`, requested at `loc`.
-    pub fn io(loc: &Loc, path: &Path, source: io::Error) -> SceneError {
+    pub fn io(loc: &Loc, path: &Path, error: io::Error) -> SceneError {
         SceneError::Io {
             loc: loc.clone(),
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 

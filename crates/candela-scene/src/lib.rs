@@ -12,6 +12,7 @@
 //! - `param`: [`ParamSet`] and its typed getters; `spectrum`: spectra.
 //! - `parser`: directive loop over a stack of included files.
 //! - `builder`, `world`: pbrt-v4 directive semantics and graphics state.
+//! - `upgrade`: pbrt-v3 syntax rewritten as pbrt-v4's `--upgrade` does.
 //! - `desc`: the output types; `math`: [`Mat4d`]; `ply`: PLY mesh reader.
 
 mod builder;
@@ -24,6 +25,7 @@ mod paramlist;
 mod parser;
 pub mod ply;
 mod spectrum;
+mod upgrade;
 mod world;
 
 use std::path::Path;

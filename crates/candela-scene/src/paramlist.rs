@@ -5,7 +5,8 @@
 //! one `f32` parse per number. Value kinds and counts are checked here so the
 //! getters in [`crate::param`] only have to check the declared type:
 //! numeric types need numbers (integers must be integer literals), tuples a
-//! multiple of their arity, `rgb` exactly three numbers, `blackbody` one,
+//! multiple of their arity, `rgb` exactly three numbers, `blackbody` one
+//! (or pbrt-v3's two: kelvin and scale),
 //! `bool` `true`/`false` (bare or quoted), `string`/`texture` quoted strings,
 //! and `spectrum` either (λ, value) pairs or one string (a built-in name or
 //! a `.spd` file, read now).
@@ -209,7 +210,10 @@ fn finish(
             let n = v.len();
             match ty {
                 ParamType::Rgb if n != 3 => return Err(count_err("3 values", n)),
-                ParamType::Blackbody if n != 1 => return Err(count_err("1 value (kelvin)", n)),
+                // pbrt-v3 wrote [kelvin scale]; `upgrade` folds the scale into lights'.
+                ParamType::Blackbody if n != 1 && n != 2 => {
+                    return Err(count_err("1 value (kelvin)", n))
+                }
                 _ if n % ty.arity() != 0 => {
                     return Err(count_err(
                         &format!("a multiple of {} values", ty.arity()),

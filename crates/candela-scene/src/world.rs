@@ -11,6 +11,7 @@ use crate::builder::{with_defaults, Block, Builder};
 use crate::desc::*;
 use crate::error::{Loc, SceneError};
 use crate::param::ParamSet;
+use crate::upgrade;
 
 type Result<T> = std::result::Result<T, SceneError>;
 
@@ -42,6 +43,10 @@ impl Builder {
                 ))
             }
         };
+        let mut params = params;
+        if let Some(w) = upgrade::texture(&class, kind == TextureKind::Float, &mut params, loc)? {
+            self.warn(loc, w);
+        }
         if !self
             .texture_names
             .insert((name.clone(), kind == TextureKind::Float))
@@ -74,6 +79,10 @@ impl Builder {
     /// `Material "type" params`: an anonymous material becomes current.
     pub(crate) fn material(&mut self, ty: String, params: ParamSet, loc: &Loc) -> Result<()> {
         self.require_world("Material", loc)?;
+        let (mut ty, mut params) = (ty, params);
+        if let Some(w) = upgrade::material(&mut ty, &mut params, loc)? {
+            self.warn(loc, w);
+        }
         let m = self.material_desc(ty, params, loc);
         self.desc.materials.push(m);
         self.gs.material = MaterialRef::Index(self.desc.materials.len() - 1);
@@ -97,6 +106,9 @@ impl Builder {
             ));
         }
         m.params.params.retain(|p| p.name != "type");
+        if let Some(w) = upgrade::material(&mut m.ty, &mut m.params, loc)? {
+            self.warn(loc, w);
+        }
         if !self.material_names.insert(name.clone()) {
             return Err(SceneError::at(
                 loc,
@@ -117,6 +129,10 @@ impl Builder {
     /// `LightSource "type" params`.
     pub(crate) fn light_source(&mut self, name: String, params: ParamSet, loc: &Loc) -> Result<()> {
         self.require_world("LightSource", loc)?;
+        let mut params = params;
+        if let Some(w) = upgrade::light(&name, &mut params, loc)? {
+            self.warn(loc, w);
+        }
         let params = with_defaults(&self.gs.attributes.light, params);
         let render_from_light = self.ctm(loc);
         self.desc.lights.push(LightDesc {
@@ -138,6 +154,10 @@ impl Builder {
         loc: &Loc,
     ) -> Result<()> {
         self.require_world("AreaLightSource", loc)?;
+        let (mut name, mut params) = (name, params);
+        if let Some(w) = upgrade::area_light(&mut name, &mut params, loc)? {
+            self.warn(loc, w);
+        }
         let params = with_defaults(&self.gs.attributes.light, params);
         self.gs.area_light = Some(self.entity(name, params, loc));
         Ok(())
@@ -146,6 +166,10 @@ impl Builder {
     /// `Shape "type" params`.
     pub(crate) fn shape(&mut self, name: String, params: ParamSet, loc: &Loc) -> Result<()> {
         self.require_world("Shape", loc)?;
+        let mut params = params;
+        if let Some(w) = upgrade::shape(&name, &mut params, loc) {
+            self.warn(loc, w);
+        }
         let params = with_defaults(&self.gs.attributes.shape, params);
         let render_from_object = self.ctm(loc);
         let mut area_light = self.gs.area_light.clone();

@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use candela_core::image::{compare, RgbImage};
 use candela_core::integrator::sppm::PpmPartial;
 use candela_core::integrator::RenderContext;
-use candela_core::scene::build::{build, Overrides};
+use candela_core::scene::build::{build, summarize, Overrides};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -24,6 +24,13 @@ struct Cli {
 enum Cmd {
     /// Render a pbrt-v4 scene to EXR (linear, float) and PNG (tone-mapped sRGB).
     Render(RenderArgs),
+    /// Parse and build a scene without rendering: print what it contains
+    /// (shapes, triangles, lights, materials, textures, camera, film, sampler,
+    /// integrator) and every warning.
+    Info {
+        /// Scene file (.pbrt, optionally .gz).
+        scene: PathBuf,
+    },
     /// Compare two EXR images: per-channel mean ratio, relMSE, MAE, worst 32×32 block.
     Diff {
         /// The image to check.
@@ -96,12 +103,17 @@ struct RenderArgs {
     /// No progress bar or statistics.
     #[arg(long)]
     quiet: bool,
+    /// Parse and build the scene, print what `candela info` prints, and stop.
+    #[arg(long)]
+    check_only: bool,
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
+        Cmd::Render(args) if args.check_only => info(&args.scene, &overrides(&args)),
         Cmd::Render(args) => render(args),
+        Cmd::Info { scene } => info(&scene, &Overrides::default()),
         Cmd::Diff { a, b, region } => diff(&a, &b, region),
         Cmd::Merge {
             scene,
@@ -127,14 +139,7 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let t0 = Instant::now();
     let desc = candela_scene::parse_file(&args.scene)?;
-    let ov = Overrides {
-        spp: args.spp,
-        integrator: args.integrator.clone(),
-        outfile: args.outfile.clone(),
-        seed: args.seed,
-        pass_range: args.pass_range,
-    };
-    let mut setup = build(&desc, &ov)?;
+    let mut setup = build(&desc, &overrides(&args))?;
     for w in &setup.warnings {
         eprintln!("candela: warning: {w}");
     }
@@ -172,6 +177,35 @@ fn render(args: RenderArgs) -> Result<()> {
             exr.display()
         );
     }
+    Ok(())
+}
+
+/// The command-line values that override the scene file.
+fn overrides(args: &RenderArgs) -> Overrides {
+    Overrides {
+        spp: args.spp,
+        integrator: args.integrator.clone(),
+        outfile: args.outfile.clone(),
+        seed: args.seed,
+        pass_range: args.pass_range,
+    }
+}
+
+/// Parses and builds `scene`, then prints its summary and load times.
+fn info(scene: &Path, ov: &Overrides) -> Result<()> {
+    let t0 = Instant::now();
+    let desc = candela_scene::parse_file(scene)?;
+    let parsed = t0.elapsed();
+    let setup = build(&desc, ov)?;
+    let total = t0.elapsed();
+    println!("scene       {}", scene.display());
+    print!("{}", summarize(&desc, &setup));
+    println!(
+        "load        {:.3} s (parse {:.3} s, build {:.3} s)",
+        total.as_secs_f64(),
+        parsed.as_secs_f64(),
+        (total - parsed).as_secs_f64()
+    );
     Ok(())
 }
 

@@ -1,16 +1,24 @@
 //! Bounding volume hierarchy over primitive bounding boxes.
 //!
 //! **Build.** Top-down, splitting each node with the surface area heuristic
-//! evaluated at bucket boundaries of the centroids' extent along the widest
-//! axis ("binned SAH", Wald 2007, "On fast construction of SAH-based bounding
-//! volume hierarchies"; pbrt-v4 §7.3.2). The cost of a split is
-//! `c_trav + (N_L·A_L + N_R·A_R) / A` with `c_trav = 1/2` relative to one
-//! primitive test; a node becomes a leaf when that is not cheaper than testing
-//! its `N ≤ 4` primitives. Larger nodes are always split; when all centroids
-//! coincide they are split in half by count. Subtrees above a size threshold
-//! build in parallel with `rayon::join`. Each subtree partitions its own slice
-//! of the primitive array in place and leaves record their offset into it,
-//! so the result does not depend on thread scheduling.
+//! along the widest axis of its primitives' centroids (pbrt-v4 §7.3.2). The
+//! cost of a split is `c_trav + (N_L·A_L + N_R·A_R) / A` with `c_trav = 1/2`
+//! relative to one primitive test; a node becomes a leaf when that is not
+//! cheaper than testing its `N ≤ 4` primitives. Larger nodes are always
+//! split; when all centroids coincide they are split in half by count.
+//! Nodes of more than 16 primitives evaluate the cost at 12 bucket
+//! boundaries ("binned SAH", Wald 2007, "On fast construction of SAH-based
+//! bounding volume hierarchies"): one pass bins the primitives, recording
+//! each bucket's count, bounds and centroid bounds, and one pass partitions
+//! them; the children's bounds and centroid bounds are unions of buckets, so
+//! no further pass over the primitives is needed. Smaller nodes sort their
+//! centroids and evaluate every boundary, which is cheaper than binning at
+//! that size and never worse. Subtrees above a size threshold build in
+//! parallel with `rayon::join`, and the binning of large nodes runs in
+//! parallel chunks (bounds unions and counts are exact, so chunking changes
+//! nothing). Each subtree partitions its own slice of the primitive array in
+//! place and leaves record their offset into it, so the result does not
+//! depend on thread scheduling.
 //!
 //! **Layout.** Nodes are flattened depth-first into 32-byte records: the
 //! first child of an interior node follows it; the record stores the second
@@ -25,15 +33,21 @@
 //! storage and hit payload.
 
 use crate::math::{gamma, Bounds3, Ray, Vec3};
+use rayon::prelude::*;
 
 /// Primitives per leaf at most.
 const MAX_LEAF_PRIMS: usize = 4;
 /// Number of SAH buckets.
-const N_BUCKETS: usize = 16;
+const N_BUCKETS: usize = 12;
 /// Cost of a traversal step relative to one primitive test.
 const TRAVERSAL_COST: f32 = 0.5;
-/// Subtrees with more primitives than this build in parallel.
+/// Subtrees with more primitives than this build (and bin) in parallel.
 const PARALLEL_THRESHOLD: usize = 16 * 1024;
+/// Primitives per parallel binning task.
+const BIN_CHUNK: usize = 8 * 1024;
+/// Nodes with at most this many primitives evaluate the SAH at every
+/// primitive boundary instead of binning.
+const SWEEP_MAX: usize = 16;
 /// Traversal stack size that needs no allocation.
 const SMALL_STACK: usize = 64;
 
@@ -110,7 +124,7 @@ impl Bvh {
         if prims.is_empty() {
             return Bvh::default();
         }
-        let (root, n_nodes, depth) = build_recursive(&mut prims, 0);
+        let (root, n_nodes, depth) = build_recursive(Span::new(&mut prims, 0));
         let mut nodes = Vec::with_capacity(n_nodes);
         flatten(&root, &mut nodes);
         Bvh {
@@ -252,51 +266,71 @@ fn slab_test(n: &BvhNode, o: Vec3, inv_dir: Vec3, neg: [bool; 3], ray_t_max: f32
     t0 <= t1
 }
 
-/// Builds the subtree over `prims`, whose first element sits at `first` in
-/// the full primitive array.
-fn build_recursive(prims: &mut [BuildPrim], first: usize) -> Built {
-    let bounds = prims.iter().fold(Bounds3::EMPTY, |b, p| b.union(p.bounds));
-    let n = prims.len();
-    let leaf = |first, count| {
-        (
-            BuildNode::Leaf {
-                bounds,
-                first,
-                count,
-            },
-            1,
-            1,
-        )
-    };
-    if n == 1 {
-        return leaf(first, n);
+/// A node's primitives with their bounds and centroid bounds.
+struct Span<'a> {
+    prims: &'a mut [BuildPrim],
+    /// Index of `prims[0]` in the full primitive array.
+    first: usize,
+    bounds: Bounds3,
+    centroids: Bounds3,
+}
+
+impl<'a> Span<'a> {
+    /// A span whose bounds are computed from its primitives.
+    fn new(prims: &'a mut [BuildPrim], first: usize) -> Self {
+        let (bounds, centroids) = bounds_of(prims);
+        Span {
+            prims,
+            first,
+            bounds,
+            centroids,
+        }
     }
-    let cb = prims
-        .iter()
-        .fold(Bounds3::EMPTY, |b, p| b.union_point(p.centroid));
-    let axis = cb.max_extent();
-    let mid = if cb.max[axis] == cb.min[axis] {
-        if n <= MAX_LEAF_PRIMS {
-            return leaf(first, n);
+}
+
+/// Bounds and centroid bounds of `prims` (in parallel for many).
+fn bounds_of(prims: &[BuildPrim]) -> (Bounds3, Bounds3) {
+    let fold =
+        |(b, c): (Bounds3, Bounds3), p: &BuildPrim| (b.union(p.bounds), c.union_point(p.centroid));
+    let empty = (Bounds3::EMPTY, Bounds3::EMPTY);
+    if prims.len() < PARALLEL_THRESHOLD {
+        return prims.iter().fold(empty, fold);
+    }
+    prims
+        .par_chunks(BIN_CHUNK)
+        .map(|c| c.iter().fold(empty, fold))
+        .reduce(|| empty, |a, b| (a.0.union(b.0), a.1.union(b.1)))
+}
+
+/// How a node ends: as a leaf, or split into two spans.
+enum Split<'a> {
+    Leaf(Span<'a>),
+    Children(Span<'a>, Span<'a>),
+}
+
+/// Builds the subtree over a span.
+fn build_recursive(span: Span) -> Built {
+    let bounds = span.bounds;
+    let axis = span.centroids.max_extent();
+    let (left, right) = match split(span, axis) {
+        Split::Leaf(s) => {
+            let (first, count) = (s.first, s.prims.len());
+            return (
+                BuildNode::Leaf {
+                    bounds,
+                    first,
+                    count,
+                },
+                1,
+                1,
+            );
         }
-        n / 2
-    } else {
-        match sah_split(prims, &bounds, &cb, axis) {
-            Some(mid) => mid,
-            None => return leaf(first, n),
-        }
+        Split::Children(l, r) => (l, r),
     };
-    let (left, right) = prims.split_at_mut(mid);
-    let ((l, ln, ld), (r, rn, rd)) = if n > PARALLEL_THRESHOLD {
-        rayon::join(
-            || build_recursive(left, first),
-            || build_recursive(right, first + mid),
-        )
+    let ((l, ln, ld), (r, rn, rd)) = if left.prims.len() + right.prims.len() > PARALLEL_THRESHOLD {
+        rayon::join(|| build_recursive(left), || build_recursive(right))
     } else {
-        (
-            build_recursive(left, first),
-            build_recursive(right, first + mid),
-        )
+        (build_recursive(left), build_recursive(right))
     };
     let node = BuildNode::Interior {
         bounds,
@@ -306,55 +340,214 @@ fn build_recursive(prims: &mut [BuildPrim], first: usize) -> Built {
     (node, 1 + ln + rn, 1 + ld.max(rd))
 }
 
-/// Chooses the cheapest bucket boundary and partitions `prims` around it;
-/// returns the size of the left part, or `None` when a leaf is cheaper.
-fn sah_split(
-    prims: &mut [BuildPrim],
-    bounds: &Bounds3,
-    cb: &Bounds3,
-    axis: usize,
-) -> Option<usize> {
-    let bucket_of = |c: Vec3| {
-        let b = (N_BUCKETS as f32 * cb.offset(c)[axis]) as usize;
-        b.min(N_BUCKETS - 1)
+/// Splits a span at the cheapest boundary along `axis` by the SAH (in half
+/// by count when the centroids coincide), or keeps it as a leaf.
+fn split(span: Span, axis: usize) -> Split {
+    let n = span.prims.len();
+    let (c0, c1) = (span.centroids.min[axis], span.centroids.max[axis]);
+    if n == 1 || (c0 == c1 && n <= MAX_LEAF_PRIMS) {
+        return Split::Leaf(span);
+    }
+    let first = span.first;
+    if c0 == c1 {
+        let (l, r) = span.prims.split_at_mut(n / 2);
+        return Split::Children(Span::new(l, first), Span::new(r, first + n / 2));
+    }
+    if n <= SWEEP_MAX {
+        return sweep_split(span, axis);
+    }
+    let binner = Binner::new(c0, c1, axis);
+    let buckets = Buckets::of(span.prims, &binner);
+    let Some((best, lb, rb)) = buckets.cheapest(&span.bounds, n) else {
+        return Split::Leaf(span);
     };
-    let mut counts = [0usize; N_BUCKETS];
-    let mut boxes = [Bounds3::EMPTY; N_BUCKETS];
-    for p in prims.iter() {
-        let b = bucket_of(p.centroid);
-        counts[b] += 1;
-        boxes[b] = boxes[b].union(p.bounds);
+    let mid = partition(span.prims, |p| binner.bucket(p.centroid) <= best);
+    debug_assert_eq!(mid, buckets.counts[..=best].iter().sum::<usize>());
+    let (lc, rc) = buckets.centroid_bounds(best);
+    let (l, r) = span.prims.split_at_mut(mid);
+    Split::Children(
+        Span {
+            prims: l,
+            first,
+            bounds: lb,
+            centroids: lc,
+        },
+        Span {
+            prims: r,
+            first: first + mid,
+            bounds: rb,
+            centroids: rc,
+        },
+    )
+}
+
+/// The SAH evaluated at every boundary between the centroid-sorted
+/// primitives of a small span (cheaper than binning when `n ≤ SWEEP_MAX`).
+fn sweep_split(span: Span, axis: usize) -> Split {
+    let n = span.prims.len();
+    span.prims
+        .sort_unstable_by(|a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
+    // below[i]: bounds of prims[..=i]; above[i]: bounds of prims[i..].
+    let (mut below, mut above) = ([Bounds3::EMPTY; SWEEP_MAX], [Bounds3::EMPTY; SWEEP_MAX]);
+    let mut b = Bounds3::EMPTY;
+    for (i, p) in span.prims.iter().enumerate() {
+        b = b.union(p.bounds);
+        below[i] = b;
     }
-    // Sweep from both ends: cost[i] for the split after bucket i.
-    let mut cost = [0.0f32; N_BUCKETS - 1];
-    let (mut below_n, mut below_b) = (0usize, Bounds3::EMPTY);
-    for i in 0..N_BUCKETS - 1 {
-        below_n += counts[i];
-        below_b = below_b.union(boxes[i]);
-        cost[i] = below_n as f32 * below_b.surface_area();
+    b = Bounds3::EMPTY;
+    for (i, p) in span.prims.iter().enumerate().rev() {
+        b = b.union(p.bounds);
+        above[i] = b;
     }
-    let (mut above_n, mut above_b) = (0usize, Bounds3::EMPTY);
-    for i in (1..N_BUCKETS).rev() {
-        above_n += counts[i];
-        above_b = above_b.union(boxes[i]);
-        cost[i - 1] += above_n as f32 * above_b.surface_area();
+    let cost = |i: usize| {
+        (i + 1) as f32 * below[i].surface_area() + (n - i - 1) as f32 * above[i + 1].surface_area()
+    };
+    let (best, best_cost) = (0..n - 1)
+        .map(|i| (i, cost(i)))
+        .fold((0, f32::INFINITY), |a, c| if c.1 < a.1 { c } else { a });
+    if !split_pays(best_cost, &span.bounds, n) {
+        return Split::Leaf(span);
     }
-    let (best, best_cost) =
-        cost.iter().enumerate().fold(
-            (0, f32::INFINITY),
-            |acc, (i, &c)| if c < acc.1 { (i, c) } else { acc },
-        );
-    let n = prims.len();
+    let (first, mid) = (span.first, best + 1);
+    let centroids = |ps: &[BuildPrim]| {
+        ps.iter()
+            .fold(Bounds3::EMPTY, |c, p| c.union_point(p.centroid))
+    };
+    let (l, r) = span.prims.split_at_mut(mid);
+    let (lc, rc) = (centroids(l), centroids(r));
+    Split::Children(
+        Span {
+            prims: l,
+            first,
+            bounds: below[best],
+            centroids: lc,
+        },
+        Span {
+            prims: r,
+            first: first + mid,
+            bounds: above[mid],
+            centroids: rc,
+        },
+    )
+}
+
+/// Whether splitting `n` primitives at SAH cost `best_cost` (Σ count·area of
+/// the children) beats a leaf; nodes above `MAX_LEAF_PRIMS` always split.
+fn split_pays(best_cost: f32, bounds: &Bounds3, n: usize) -> bool {
     let area = bounds.surface_area();
     let split_cost = if area > 0.0 {
         TRAVERSAL_COST + best_cost / area
     } else {
         f32::INFINITY
     };
-    if n <= MAX_LEAF_PRIMS && split_cost >= n as f32 {
-        return None;
+    n > MAX_LEAF_PRIMS || split_cost < n as f32
+}
+
+/// Maps a centroid to one of `N_BUCKETS` equal slices of `[c0, c1]` along an axis.
+#[derive(Clone, Copy)]
+struct Binner {
+    axis: usize,
+    min: f32,
+    scale: f32,
+}
+
+impl Binner {
+    fn new(c0: f32, c1: f32, axis: usize) -> Self {
+        Binner {
+            axis,
+            min: c0,
+            scale: N_BUCKETS as f32 / (c1 - c0),
+        }
     }
-    Some(partition(prims, |p| bucket_of(p.centroid) <= best))
+
+    /// The bucket of centroid `c` (the float-to-int cast saturates at 0).
+    #[inline]
+    fn bucket(&self, c: Vec3) -> usize {
+        (((c[self.axis] - self.min) * self.scale) as usize).min(N_BUCKETS - 1)
+    }
+}
+
+/// Per-bucket primitive counts, bounds and centroid bounds.
+#[derive(Clone, Copy)]
+struct Buckets {
+    counts: [usize; N_BUCKETS],
+    boxes: [Bounds3; N_BUCKETS],
+    centroids: [Bounds3; N_BUCKETS],
+}
+
+impl Buckets {
+    const EMPTY: Buckets = Buckets {
+        counts: [0; N_BUCKETS],
+        boxes: [Bounds3::EMPTY; N_BUCKETS],
+        centroids: [Bounds3::EMPTY; N_BUCKETS],
+    };
+
+    /// Bins `prims` (in parallel chunks for many; bounds unions and counts
+    /// are exact, so the result does not depend on the chunking).
+    fn of(prims: &[BuildPrim], binner: &Binner) -> Buckets {
+        let bin = |chunk: &[BuildPrim]| {
+            let mut b = Buckets::EMPTY;
+            for p in chunk {
+                let i = binner.bucket(p.centroid);
+                b.counts[i] += 1;
+                b.boxes[i] = b.boxes[i].union(p.bounds);
+                b.centroids[i] = b.centroids[i].union_point(p.centroid);
+            }
+            b
+        };
+        if prims.len() < PARALLEL_THRESHOLD {
+            return bin(prims);
+        }
+        prims
+            .par_chunks(BIN_CHUNK)
+            .map(bin)
+            .reduce(|| Buckets::EMPTY, Buckets::merge)
+    }
+
+    fn merge(mut self, o: Buckets) -> Buckets {
+        for i in 0..N_BUCKETS {
+            self.counts[i] += o.counts[i];
+            self.boxes[i] = self.boxes[i].union(o.boxes[i]);
+            self.centroids[i] = self.centroids[i].union(o.centroids[i]);
+        }
+        self
+    }
+
+    /// Centroid bounds of the buckets up to and including `best`, and after it.
+    fn centroid_bounds(&self, best: usize) -> (Bounds3, Bounds3) {
+        let u =
+            |r: std::ops::Range<usize>| r.fold(Bounds3::EMPTY, |c, i| c.union(self.centroids[i]));
+        (u(0..best + 1), u(best + 1..N_BUCKETS))
+    }
+
+    /// The bucket after which splitting is cheapest by the SAH, with the
+    /// bounds of both sides, or `None` when a leaf of these `n` primitives
+    /// is cheaper (only for `n ≤ MAX_LEAF_PRIMS`).
+    fn cheapest(&self, bounds: &Bounds3, n: usize) -> Option<(usize, Bounds3, Bounds3)> {
+        // below[i]: buckets ..=i; above[i]: buckets i..; cost[i] for the split after bucket i.
+        let (mut below, mut above) = ([Bounds3::EMPTY; N_BUCKETS], [Bounds3::EMPTY; N_BUCKETS]);
+        let mut cost = [0.0f32; N_BUCKETS - 1];
+        let (mut count, mut b) = (0usize, Bounds3::EMPTY);
+        for i in 0..N_BUCKETS - 1 {
+            count += self.counts[i];
+            b = b.union(self.boxes[i]);
+            below[i] = b;
+            cost[i] = count as f32 * b.surface_area();
+        }
+        let (mut count, mut b) = (0usize, Bounds3::EMPTY);
+        for i in (1..N_BUCKETS).rev() {
+            count += self.counts[i];
+            b = b.union(self.boxes[i]);
+            above[i] = b;
+            cost[i - 1] += count as f32 * b.surface_area();
+        }
+        let (best, best_cost) =
+            cost.iter().enumerate().fold(
+                (0, f32::INFINITY),
+                |acc, (i, &c)| if c < acc.1 { (i, c) } else { acc },
+            );
+        split_pays(best_cost, bounds, n).then_some((best, below[best], above[best + 1]))
+    }
 }
 
 /// In-place partition; returns the number of elements satisfying `pred`,

@@ -87,6 +87,14 @@ impl Sampler {
         }
     }
 
+    /// Which sampler this is.
+    pub fn kind(&self) -> SamplerKind {
+        match self {
+            Sampler::Independent(_) => SamplerKind::Independent,
+            Sampler::PaddedSobol(_) => SamplerKind::PaddedSobol,
+        }
+    }
+
     /// Samples per pixel.
     pub fn samples_per_pixel(&self) -> u32 {
         dispatch!(self, s => s.samples_per_pixel())

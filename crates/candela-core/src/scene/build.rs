@@ -12,7 +12,10 @@ mod lights;
 mod materials;
 mod shapes;
 mod spectra;
+mod summary;
 mod textures;
+
+pub use summary::{summarize, Counts, SceneSummary};
 
 use crate::camera::Camera;
 use crate::film::RgbFilm;

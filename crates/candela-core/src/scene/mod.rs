@@ -15,6 +15,7 @@ use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
 use crate::shape::WatertightRay;
 use crate::spectrum::SampledWavelengths;
 use crate::texture::TextureEvalContext;
+use rayon::prelude::*;
 
 /// Everything rays can hit or be lit by.
 pub struct Scene {
@@ -35,7 +36,7 @@ impl Scene {
         mut lights: Vec<Light>,
         power_sampling: bool,
     ) -> Self {
-        let prim_bounds: Vec<Bounds3> = primitives.iter().map(|p| p.shape.bounds()).collect();
+        let prim_bounds: Vec<Bounds3> = primitives.par_iter().map(|p| p.shape.bounds()).collect();
         let bounds = prim_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
         let bvh = Bvh::build(&prim_bounds);
         for l in &mut lights {
@@ -68,6 +69,10 @@ impl Scene {
     /// Number of primitives.
     pub fn primitive_count(&self) -> usize {
         self.primitives.len()
+    }
+    /// All primitives.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.primitives
     }
     /// All lights.
     pub fn lights(&self) -> &[Light] {

@@ -80,6 +80,12 @@ pub fn named_spectrum(name: &str) -> Option<Spectrum> {
         "stdillum-A" => Spectrum::PiecewiseLinear(illuminant_a()),
         "metal-Cu-eta" => table(&metals::CU_LAMBDA, &metals::CU_ETA),
         "metal-Cu-k" => table(&metals::CU_LAMBDA, &metals::CU_K),
+        "metal-Ag-eta" => table(&metals::CU_LAMBDA, &metals::AG_ETA),
+        "metal-Ag-k" => table(&metals::CU_LAMBDA, &metals::AG_K),
+        "metal-Al-eta" => table(&metals::CU_LAMBDA, &metals::AL_ETA),
+        "metal-Al-k" => table(&metals::CU_LAMBDA, &metals::AL_K),
+        "metal-Au-eta" => table(&metals::CU_LAMBDA, &metals::AU_ETA),
+        "metal-Au-k" => table(&metals::CU_LAMBDA, &metals::AU_K),
         "glass-BK7" => sellmeier(
             [1.039_612_12, 0.231_792_344, 1.010_469_45],
             [0.006_000_698_67, 0.020_017_914_4, 103.560_653],

@@ -161,6 +161,26 @@ fn named_glasses_and_metals() {
 }
 
 #[test]
+fn silver_aluminium_and_gold_reflect_like_the_metals_they_are() {
+    // Normal-incidence reflectance ((n − 1)² + k²) / ((n + 1)² + k²).
+    let r = |metal: &str, lambda: f32| {
+        let n = named_spectrum(&format!("metal-{metal}-eta"))
+            .unwrap()
+            .eval(lambda);
+        let k = named_spectrum(&format!("metal-{metal}-k"))
+            .unwrap()
+            .eval(lambda);
+        ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
+    };
+    // Silver and aluminium are bright and nearly neutral; gold is dark in
+    // the blue and bright in the red (published values ≈ 0.97, 0.92, 0.38, 0.95).
+    assert!((r("Ag", 550.0) - 0.97).abs() < 0.02, "{}", r("Ag", 550.0));
+    assert!((r("Al", 550.0) - 0.92).abs() < 0.02, "{}", r("Al", 550.0));
+    assert!((r("Au", 450.0) - 0.38).abs() < 0.04, "{}", r("Au", 450.0));
+    assert!((r("Au", 650.0) - 0.95).abs() < 0.02, "{}", r("Au", 650.0));
+}
+
+#[test]
 fn blackbody_is_normalised_to_its_peak() {
     let b = Spectrum::blackbody(6500.0);
     let peak = 2.897_772e-3 / 6500.0 * 1e9;

@@ -1,6 +1,10 @@
 //! Shared helpers for the integration tests: render a scene given as text
 //! and measure image statistics. Each test binary uses a subset of them.
 #![allow(dead_code)]
+// Every test binary compiles its own copy of this module and uses a subset.
+#![allow(dead_code)]
+
+pub mod stats;
 
 use candela_core::image::RgbImage;
 use candela_core::integrator::{NoProgress, RenderContext};

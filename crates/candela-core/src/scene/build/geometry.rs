@@ -75,6 +75,7 @@ fn add_shape(
         .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
     let render_from_object = parent.then_after(&object);
     let shapes = build_shape(s, &render_from_object)?;
+    prims.reserve(shapes.len());
     for shape in shapes {
         let area_light = match &s.area_light {
             Some(a) => {

@@ -19,7 +19,7 @@ use crate::shape::{
     loop_subdivide, BilinearPatch, BilinearPatchMesh, Cylinder, Disk, Shape, Sphere, Triangle,
     TriangleMesh,
 };
-use candela_scene::{ParamSet, ShapeDesc};
+use candela_scene::{ParamSet, SceneError, ShapeDesc};
 use std::sync::Arc;
 
 /// The shapes one `Shape` directive creates, placed by `t`.
@@ -167,10 +167,16 @@ fn triangles(s: &ShapeDesc, t: &Transform, m: MeshInput) -> Result<Vec<Shape>, B
         m.face,
     )
     .map_err(|e| BuildError::at(&s.loc, format!("invalid triangle mesh: {e}")))?;
-    Ok(Triangle::all(&Arc::new(mesh))
-        .into_iter()
-        .map(Shape::Triangle)
-        .collect())
+    Ok(triangle_shapes(mesh))
+}
+
+/// One shape per triangle of `mesh` (collected straight into shapes: a
+/// million-triangle mesh would otherwise be copied through a `Vec<Triangle>`).
+fn triangle_shapes(mesh: TriangleMesh) -> Vec<Shape> {
+    let mesh = Arc::new(mesh);
+    (0..mesh.triangle_count() as u32)
+        .map(|i| Shape::Triangle(Triangle::new(mesh.clone(), i)))
+        .collect()
 }
 
 fn trianglemesh(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
@@ -189,7 +195,15 @@ fn plymesh(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
             "plymesh \"displacement\" is not supported yet",
         ));
     }
-    let m = candela_scene::read_ply(&file).map_err(|e| BuildError::at(&s.loc, format!("{e}")))?;
+    // A missing file is reported at the "filename" parameter; a malformed
+    // one at the directive, followed by the place in the PLY file.
+    let m = candela_scene::read_ply(&file).map_err(|e| match e {
+        SceneError::Io { path, error, .. } => {
+            let at = p.param_loc("filename").unwrap_or(&s.loc);
+            BuildError::Scene(SceneError::io(at, &path, error))
+        }
+        other => BuildError::at(&s.loc, format!("bad PLY file: {other}")),
+    })?;
     let input = MeshInput {
         p: m.positions,
         indices: m.indices.iter().map(|&i| i as i32).collect(),
@@ -260,8 +274,5 @@ fn loopsubdiv(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
         None,
     )
     .map_err(|e| BuildError::at(&s.loc, format!("invalid subdivided mesh: {e}")))?;
-    Ok(Triangle::all(&Arc::new(mesh))
-        .into_iter()
-        .map(Shape::Triangle)
-        .collect())
+    Ok(triangle_shapes(mesh))
 }
