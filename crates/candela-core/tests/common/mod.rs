@@ -1,5 +1,8 @@
 //! Shared helpers for the integration tests: render a scene given as text
 //! and measure image statistics.
+//!
+//! Each test binary includes this module and uses only part of it.
+#![allow(dead_code)]
 
 use candela_core::image::RgbImage;
 use candela_core::integrator::{NoProgress, RenderContext};
