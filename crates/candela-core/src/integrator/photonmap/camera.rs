@@ -21,8 +21,10 @@ pub struct CameraWalk<'a> {
     pub maps: &'a PassMaps,
     /// Integrator settings.
     pub settings: &'a PhotonMapSettings,
-    /// Lookup parameters (radius resolved).
-    pub lookup: Lookup,
+    /// Global-map lookups (radius resolved).
+    pub global_lookup: Lookup,
+    /// Caustic-map lookups (radius resolved).
+    pub caustic_lookup: Lookup,
 }
 
 /// A non-specular vertex of the camera path (or of a gather ray).
@@ -97,13 +99,13 @@ impl CameraWalk<'_> {
         let caustic = self
             .maps
             .caustic
-            .radiance(&self.query(v), &self.lookup, scratch);
+            .radiance(&self.query(v), &self.caustic_lookup, scratch);
         let indirect = if self.settings.final_gather {
             self.final_gather(v, lambda, sampler, scratch)
         } else {
             self.maps
                 .global
-                .radiance(&self.query(v), &self.lookup, scratch)
+                .radiance(&self.query(v), &self.global_lookup, scratch)
         };
         direct + caustic + indirect
     }
@@ -216,7 +218,7 @@ impl CameraWalk<'_> {
                     * self
                         .maps
                         .global
-                        .radiance(&self.query(&v), &self.lookup, scratch);
+                        .radiance(&self.query(&v), &self.global_lookup, scratch);
             }
             let Some(bs) = sample_delta(&bsdf, wo, sampler) else {
                 break;

@@ -53,7 +53,8 @@
 //! | `photons` | integer | 100000 | photon paths per pass for the global map |
 //! | `causticphotons` | integer | 100000 | photon paths per pass for the caustic map |
 //! | `lookup` | integer | 50 | photons per radiance estimate, k (at least 2) |
-//! | `maxradius` | float | 0.05·R_scene | cap on the lookup radius; R_scene the scene's bounding-sphere radius (after Mitsuba 0.6's relative lookup radius) |
+//! | `maxradius` | float | 0.05·R_scene | cap on the global-map lookup radius; R_scene the scene's bounding-sphere radius (Mitsuba 0.6's relative default) |
+//! | `causticmaxradius` | float | `maxradius`/4 | cap on the caustic-map lookup radius (Mitsuba 0.6's ratio, 0.0125 to 0.05) |
 //! | `kernel` | string | `cone` | `cone`, `epanechnikov` or `disk` |
 //! | `conek` | float | 1.1 | κ of the cone filter w = 1 − d/(κr) |
 //! | `finalgather` | bool | true | gather indirect light one bounce away |
@@ -90,8 +91,11 @@ pub struct PhotonMapSettings {
     pub caustic_photons: u64,
     /// Photons per radiance estimate (k ≥ 2).
     pub lookup: usize,
-    /// Largest lookup radius; `None`: [`DEFAULT_RELATIVE_RADIUS`] of the scene's bounding radius.
+    /// Largest global-map lookup radius; `None`: [`DEFAULT_RELATIVE_RADIUS`]
+    /// of the scene's bounding radius.
     pub max_radius: Option<f32>,
+    /// Largest caustic-map lookup radius; `None`: a quarter of the global one.
+    pub caustic_max_radius: Option<f32>,
     /// Density-estimation kernel.
     pub kernel: Kernel,
     /// Estimate indirect light by final gathering (else read the global map at the camera vertex).
@@ -110,6 +114,7 @@ impl Default for PhotonMapSettings {
             caustic_photons: 100_000,
             lookup: 50,
             max_radius: None,
+            caustic_max_radius: None,
             kernel: Kernel::Cone(1.1),
             final_gather: true,
             gather_rays: 16,
@@ -128,7 +133,7 @@ impl Integrator for PhotonMapIntegrator {
     fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
         let passes = ctx.sampler.samples_per_pixel();
         ctx.progress.start(passes as u64, "passes");
-        let lookup = self.lookup(ctx);
+        let (global_lookup, caustic_lookup) = self.lookups(ctx);
         for pass in 0..passes {
             let lambda = pass_wavelengths(self.settings.seed, pass, passes);
             let maps = PassMaps::shoot(ctx.scene, &lambda, &self.settings, pass as u64);
@@ -136,7 +141,8 @@ impl Integrator for PhotonMapIntegrator {
                 scene: ctx.scene,
                 maps: &maps,
                 settings: &self.settings,
-                lookup,
+                global_lookup,
+                caustic_lookup,
             };
             for tile in render_pass(&walk, ctx, film, pass, &lambda) {
                 film.merge_tile(tile);
@@ -148,17 +154,21 @@ impl Integrator for PhotonMapIntegrator {
 }
 
 impl PhotonMapIntegrator {
-    /// The lookup parameters, with the default radius resolved against the scene.
-    fn lookup(&self, ctx: &RenderContext<'_>) -> Lookup {
+    /// The global and caustic lookup parameters, default radii resolved against the scene.
+    fn lookups(&self, ctx: &RenderContext<'_>) -> (Lookup, Lookup) {
         let s = &self.settings;
-        let max_radius = s
+        let global = s
             .max_radius
             .unwrap_or_else(|| DEFAULT_RELATIVE_RADIUS * ctx.scene.bounds().bounding_sphere().1);
-        Lookup {
+        let lookup = |max_radius| Lookup {
             k: s.lookup.max(2),
             max_radius,
             kernel: s.kernel,
-        }
+        };
+        (
+            lookup(global),
+            lookup(s.caustic_max_radius.unwrap_or(global / 4.0)),
+        )
     }
 }
 

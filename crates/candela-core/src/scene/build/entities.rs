@@ -349,22 +349,21 @@ fn photonmap_settings(
             ))
         }
     };
-    let max_radius = match p.get_floats("maxradius")? {
-        None => None,
-        Some(v) if v.len() == 1 && v[0] > 0.0 => Some(v[0]),
-        Some(_) => {
-            return Err(BuildError::at(
-                loc,
-                "\"maxradius\" must be one positive float",
-            ))
-        }
+    let radius = |name: &str| match p.get_floats(name)? {
+        None => Ok(None),
+        Some(v) if v.len() == 1 && v[0] > 0.0 => Ok(Some(v[0])),
+        Some(_) => Err(BuildError::at(
+            loc,
+            format!("\"{name}\" must be one positive float"),
+        )),
     };
     Ok(PhotonMapSettings {
         max_depth,
         photons: count("photons", d.photons)?,
         caustic_photons: count("causticphotons", d.caustic_photons)?,
         lookup: count("lookup", d.lookup as u64)?.max(2) as usize,
-        max_radius,
+        max_radius: radius("maxradius")?,
+        caustic_max_radius: radius("causticmaxradius")?,
         kernel,
         final_gather: p.get_bool("finalgather", d.final_gather)?,
         gather_rays: count("gatherrays", d.gather_rays as u64)? as u32,
