@@ -1,8 +1,8 @@
 //! `Integrator "photonmap"` against closed forms and other integrators.
 //!
-//! Pixels of one render share that render's photon maps, so their errors are
-//! correlated and the spread over pixels says nothing about the error of the
-//! image mean. Every statistical check here therefore renders K independent
+//! Pixels of one render share its photon maps and pass wavelengths, so
+//! their errors are correlated and the spread over pixels says nothing about
+//! the error of the image mean. Every statistical check here therefore renders K independent
 //! seeds (independent maps) and measures σ from the spread of the K
 //! per-render means: |mean − expected| ≤ 5σ/√K + b (validation.md), b a
 //! stated deterministic allowance.
