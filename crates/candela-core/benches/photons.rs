@@ -3,6 +3,8 @@
 //! of 1 and 2 threads, so the report gives photons/s and the 1 → 2 thread
 //! scaling of the photon pass.
 
+#![allow(missing_docs)]
+
 use candela_core::integrator::photon::{trace_photon, ShootSettings};
 use candela_core::scene::build::{build, Overrides, RenderSetup};
 use candela_core::spectrum::SampledWavelengths;
@@ -25,6 +27,7 @@ fn shoot(rs: &RenderSetup, pass: u64) -> u64 {
     let settings = ShootSettings {
         max_depth: 20,
         seed: 1,
+        caustic_only: false,
     };
     (0..PHOTONS / 1024)
         .into_par_iter()

@@ -33,6 +33,7 @@ fn first_hits(rs: &RenderSetup, n: u64) -> Vec<(f32, f32)> {
     let settings = ShootSettings {
         max_depth: 1,
         seed: 11,
+        caustic_only: false,
     };
     (0..n)
         .into_par_iter()
@@ -106,6 +107,7 @@ Shape "sphere" "float radius" [1]
     let settings = ShootSettings {
         max_depth: 10_000,
         seed: 5,
+        caustic_only: false,
     };
     let n = 200_000u64;
     let per_photon: Vec<(f64, f64)> = (0..n)

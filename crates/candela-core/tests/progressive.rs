@@ -46,6 +46,7 @@ Shape "trianglemesh" "point3 P" [-1000 -1000 0  1000 -1000 0  1000 1000 0  -1000
             let settings = ShootSettings {
                 max_depth: 1,
                 seed: 99,
+                caustic_only: false,
             };
             let mut sum = 0.0f64;
             for i in 0..n {

@@ -3,18 +3,21 @@
 //! Every integrator implements [`Integrator`]. Camera-driven ones implement
 //! [`PixelEstimator`] and share the tiled driver in [`driver`], which owns
 //! threads, tiles, progress and deterministic accumulation (Tungsten's split
-//! of driver / per-path tracer / settings).
+//! of driver / per-path tracer / settings). Photon mapping renders pass by
+//! pass, each pass with its own photon maps, and has its own loop.
 
 mod bdpt;
 pub mod driver;
 mod light_tracer;
 mod path;
 pub mod photon;
+pub mod photonmap;
 pub mod sppm;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::LightTracer;
 pub use path::{PathIntegrator, PathSettings};
+pub use photonmap::{PhotonMapIntegrator, PhotonMapSettings};
 pub use sppm::{PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings};
 
 use crate::camera::Camera;

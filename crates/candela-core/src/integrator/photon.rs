@@ -61,6 +61,9 @@ pub struct ShootSettings {
     pub max_depth: u32,
     /// Seed of the photon random numbers.
     pub seed: u64,
+    /// End a photon at its first non-specular scattering: only caustic
+    /// (L S+ D) hits are wanted, so the rest of the path would be wasted.
+    pub caustic_only: bool,
 }
 
 /// Uniform numbers of one photon.
@@ -140,6 +143,9 @@ pub fn trace_photon(
             * bs.f
             * (shading_correction(&si, wo, bs.wi) * bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0);
         caustic &= bs.is_specular();
+        if settings.caustic_only && !caustic {
+            break;
+        }
         // Russian roulette keeps |β| roughly constant [pbrt-v4 SPPM photon pass].
         let survive = (new_beta.max_component() / beta.max_component()).min(1.0);
         if survive.is_nan() || survive <= 0.0 || rng.u1() >= survive {

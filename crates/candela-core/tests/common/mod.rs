@@ -1,7 +1,7 @@
 //! Shared helpers for the integration tests: render a scene given as text
-//! and measure image statistics. Each test binary uses a subset of them.
-#![allow(dead_code)]
-// Every test binary compiles its own copy of this module and uses a subset.
+//! and measure image statistics.
+//!
+//! Each test binary includes this module and uses only part of it.
 #![allow(dead_code)]
 
 pub mod stats;

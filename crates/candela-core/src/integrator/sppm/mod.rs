@@ -106,6 +106,7 @@ impl SppmSettings {
         ShootSettings {
             max_depth: self.max_depth,
             seed: self.seed,
+            caustic_only: false,
         }
     }
 }

@@ -172,6 +172,7 @@ impl PpmIntegrator {
         let shoot = ShootSettings {
             max_depth: st.max_depth,
             seed: st.seed,
+            caustic_only: false,
         };
         let mut sums = vec![[0i128; 3]; pixels.len()];
         ctx.progress.start(end.saturating_sub(begin), "passes");

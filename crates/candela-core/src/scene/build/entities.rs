@@ -4,9 +4,11 @@ use super::{BuildError, Overrides};
 use crate::camera::{Camera, CameraParams};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{FilmSettings, RgbFilm};
+use crate::integrator::photonmap::Kernel;
 use crate::integrator::{
     BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings,
-    PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, Visualize,
+    PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator, PpmSettings, SppmIntegrator,
+    SppmSettings, Visualize,
 };
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
@@ -265,12 +267,19 @@ pub fn integrator(
     };
     match name.as_str() {
         "lightpath" => {
-            let seed = match (ov.seed, &desc.sampler) {
-                (Some(s), _) => s,
-                (None, Some(e)) => e.params.get_int("seed", 0)? as u64,
-                (None, None) => 0,
-            };
+            let seed = render_seed(desc, ov)?;
             return Ok((Box::new(LightTracer { max_depth, seed }), name, power));
+        }
+        "photonmap" => {
+            if !power {
+                warnings.push(format!(
+                    "{}: \"photonmap\" always chooses lights by power; \"lightsampler\" is ignored",
+                    e.loc
+                ));
+            }
+            let settings = photonmap_settings(p, max_depth, render_seed(desc, ov)?, &e.loc)?;
+            let pm = PhotonMapIntegrator { settings };
+            return Ok((Box::new(pm), name, true));
         }
         "bdpt" => {
             let strategies = p.get_bool("visualizestrategies", false)?;
@@ -335,7 +344,7 @@ pub fn integrator(
             e.loc
         )),
         other => {
-            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath, bdpt, sppm, ppm)")));
+            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath, bdpt, sppm, ppm, photonmap)")));
         }
     }
     let settings = PathSettings {
@@ -343,4 +352,61 @@ pub fn integrator(
         regularize,
     };
     Ok((Box::new(PathIntegrator { settings }), name, power))
+}
+
+/// The seed of integrators that draw their own random numbers (`--seed`,
+/// else the sampler's `seed`).
+fn render_seed(desc: &SceneDescription, ov: &Overrides) -> Result<u64, BuildError> {
+    Ok(match (ov.seed, &desc.sampler) {
+        (Some(s), _) => s,
+        (None, Some(e)) => e.params.get_int("seed", 0)? as u64,
+        (None, None) => 0,
+    })
+}
+
+/// `Integrator "photonmap"` parameters (table in `integrator::photonmap`).
+fn photonmap_settings(
+    p: &candela_scene::ParamSet,
+    max_depth: u32,
+    seed: u64,
+    loc: &candela_scene::Loc,
+) -> Result<PhotonMapSettings, BuildError> {
+    let d = PhotonMapSettings::default();
+    let count = |name: &str, def: u64| -> Result<u64, BuildError> {
+        Ok(p.get_int(name, def as i32)?.max(0) as u64)
+    };
+    let kernel = match p.get_string("kernel", "cone")?.as_str() {
+        "cone" => match p.get_float("conek", 1.1)? {
+            k if k >= 1.0 => Kernel::Cone(k),
+            _ => return Err(BuildError::at(loc, "\"conek\" must be at least 1")),
+        },
+        "epanechnikov" => Kernel::Epanechnikov,
+        "disk" => Kernel::Disk,
+        other => {
+            return Err(BuildError::at(
+                loc,
+                format!("unknown kernel \"{other}\" (known: cone, epanechnikov, disk)"),
+            ))
+        }
+    };
+    let radius = |name: &str| match p.get_floats(name)? {
+        None => Ok(None),
+        Some(v) if v.len() == 1 && v[0] > 0.0 => Ok(Some(v[0])),
+        Some(_) => Err(BuildError::at(
+            loc,
+            format!("\"{name}\" must be one positive float"),
+        )),
+    };
+    Ok(PhotonMapSettings {
+        max_depth,
+        photons: count("photons", d.photons)?,
+        caustic_photons: count("causticphotons", d.caustic_photons)?,
+        lookup: count("lookup", d.lookup as u64)?.max(2) as usize,
+        max_radius: radius("maxradius")?,
+        caustic_max_radius: radius("causticmaxradius")?,
+        kernel,
+        final_gather: p.get_bool("finalgather", d.final_gather)?,
+        gather_rays: count("gatherrays", d.gather_rays as u64)? as u32,
+        seed,
+    })
 }

@@ -1,0 +1,216 @@
+//! Classic two-pass photon mapping (`Integrator "photonmap"`) [Jensen 1996,
+//! "Global Illumination using Photon Maps"; Jensen 2001, "Realistic Image
+//! Synthesis Using Photon Mapping", ch. 9].
+//!
+//! **Passes and wavelengths.** A render is `spp` independent passes. Pass i
+//! draws one set of four stratified wavelengths, with the offset u jittered
+//! by hash(seed, i) inside stratum i of the `spp` strata of [0, 1) (every
+//! pixel of a pass shares its wavelengths, so unstratified passes would
+//! tint the whole image at random), shoots
+//! its own global and caustic photon maps at those wavelengths (`photons`
+//! and `causticphotons` paths), builds their kd-trees, and then renders one
+//! filter-sampled camera sample per pixel with the same wavelengths, so that
+//! f·ΔΦ is formed spectrally at exactly the wavelengths the photons carry
+//! (see `photon.rs`). The film averages the passes. The rendering loop is
+//! parallel over 16×16 tiles and merges them in a fixed order, photons come
+//! from per-(pass, index) streams, so the image does not depend on the
+//! thread count. More passes average out noise, not the kernel bias of one
+//! pass's maps: that shrinks only with more photons per pass or a smaller
+//! `lookup`.
+//!
+//! **Partition of the light paths** [Jensen 2001, §9.1: reflected radiance
+//! split into direct, specular, caustic and indirect parts]. The camera path follows
+//! the specular (delta) lobes from the eye; emission it meets is always
+//! counted, since no other estimator produces E S* L paths. At every vertex
+//! x with a non-specular lobe the incident light is split by its light
+//! subpath:
+//! - x ← L, **direct**: next-event estimation, light sampling only (the
+//!   camera never continues along a non-specular lobe, so nothing else
+//!   finds these paths and no MIS is needed);
+//! - x ← S+ ← L, **caustic**: the caustic map at x;
+//! - x ← (anything containing a non-specular vertex) ← L, **indirect**:
+//!   with `finalgather`, `gatherrays` rays sample the BSDF's non-specular
+//!   part, follow delta lobes to the first vertex y with a non-specular
+//!   lobe and read there the global map holding *every* photon hit (all the
+//!   light reaching y, direct and caustic included, is indirect for x; y's
+//!   own emission is not, so gather rays ignore emission). Without it the
+//!   global map is read at x itself and must then hold only hits with depth
+//!   ≥ 2 that are not L S+ D.
+//!
+//! The delta part of x's BSDF continues the camera path; a continuation
+//! that samples a non-specular lobe is dropped, since the three terms above
+//! already cover it. Each path is so counted exactly once.
+//!
+//! **Depth.** `maxdepth` bounds the scattering events of a whole path as in
+//! the path tracer. A photon stored at its d-th hit and read at the camera
+//! path's j-th scattering vertex closes a path with j + d − 1 of them, so
+//! lookups ignore photons with d > maxdepth − j + 1.
+//!
+//! Parameters (Mitsuba-style table):
+//!
+//! | name | type | default | meaning |
+//! |---|---|---|---|
+//! | `photons` | integer | 100000 | photon paths per pass for the global map |
+//! | `causticphotons` | integer | 100000 | photon paths per pass for the caustic map |
+//! | `lookup` | integer | 50 | photons per radiance estimate, k (at least 2) |
+//! | `maxradius` | float | 0.05·R_scene | cap on the global-map lookup radius; R_scene the scene's bounding-sphere radius (Mitsuba 0.6's relative default) |
+//! | `causticmaxradius` | float | `maxradius`/4 | cap on the caustic-map lookup radius (Mitsuba 0.6's ratio, 0.0125 to 0.05) |
+//! | `kernel` | string | `cone` | `cone`, `epanechnikov` or `disk` |
+//! | `conek` | float | 1.1 | κ of the cone filter w = 1 − d/(κr) |
+//! | `finalgather` | bool | true | gather indirect light one bounce away |
+//! | `gatherrays` | integer | 16 | final-gather rays per non-specular camera vertex |
+//! | `maxdepth` | integer | 5 | scattering events per path |
+//!
+//! Lights are always chosen in proportion to their power.
+
+mod camera;
+mod maps;
+
+pub use maps::{Kernel, Lookup, Photon, PhotonMap};
+
+use super::{driver, Integrator, RenderContext};
+use crate::film::{FilmTile, RgbFilm};
+use crate::math::UVec2;
+use crate::sampling::{hash_u64s, Pcg32};
+use crate::spectrum::SampledWavelengths;
+use camera::CameraWalk;
+use maps::PassMaps;
+use rayon::prelude::*;
+
+/// Default `maxradius` as a fraction of the scene's bounding-sphere radius.
+pub const DEFAULT_RELATIVE_RADIUS: f32 = 0.05;
+
+/// Parameters of `Integrator "photonmap"`.
+#[derive(Clone, Debug)]
+pub struct PhotonMapSettings {
+    /// Scattering events per path.
+    pub max_depth: u32,
+    /// Photon paths per pass for the global map.
+    pub photons: u64,
+    /// Photon paths per pass for the caustic map.
+    pub caustic_photons: u64,
+    /// Photons per radiance estimate (k ≥ 2).
+    pub lookup: usize,
+    /// Largest global-map lookup radius; `None`: [`DEFAULT_RELATIVE_RADIUS`]
+    /// of the scene's bounding radius.
+    pub max_radius: Option<f32>,
+    /// Largest caustic-map lookup radius; `None`: a quarter of the global one.
+    pub caustic_max_radius: Option<f32>,
+    /// Density-estimation kernel.
+    pub kernel: Kernel,
+    /// Estimate indirect light by final gathering (else read the global map at the camera vertex).
+    pub final_gather: bool,
+    /// Final-gather rays per non-specular camera vertex.
+    pub gather_rays: u32,
+    /// Seed of wavelengths and photons.
+    pub seed: u64,
+}
+
+impl Default for PhotonMapSettings {
+    fn default() -> Self {
+        Self {
+            max_depth: 5,
+            photons: 100_000,
+            caustic_photons: 100_000,
+            lookup: 50,
+            max_radius: None,
+            caustic_max_radius: None,
+            kernel: Kernel::Cone(1.1),
+            final_gather: true,
+            gather_rays: 16,
+            seed: 0,
+        }
+    }
+}
+
+/// The photon-mapping integrator.
+pub struct PhotonMapIntegrator {
+    /// Settings.
+    pub settings: PhotonMapSettings,
+}
+
+impl Integrator for PhotonMapIntegrator {
+    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
+        let passes = ctx.sampler.samples_per_pixel();
+        ctx.progress.start(passes as u64, "passes");
+        let (global_lookup, caustic_lookup) = self.lookups(ctx);
+        for pass in 0..passes {
+            let lambda = pass_wavelengths(self.settings.seed, pass, passes);
+            let maps = PassMaps::shoot(ctx.scene, &lambda, &self.settings, pass as u64);
+            let walk = CameraWalk {
+                scene: ctx.scene,
+                maps: &maps,
+                settings: &self.settings,
+                global_lookup,
+                caustic_lookup,
+            };
+            for tile in render_pass(&walk, ctx, film, pass, &lambda) {
+                film.merge_tile(tile);
+            }
+            ctx.progress.advance(1);
+        }
+        ctx.progress.finish();
+    }
+}
+
+impl PhotonMapIntegrator {
+    /// The global and caustic lookup parameters, default radii resolved against the scene.
+    fn lookups(&self, ctx: &RenderContext<'_>) -> (Lookup, Lookup) {
+        let s = &self.settings;
+        let global = s
+            .max_radius
+            .unwrap_or_else(|| DEFAULT_RELATIVE_RADIUS * ctx.scene.bounds().bounding_sphere().1);
+        let lookup = |max_radius| Lookup {
+            k: s.lookup.max(2),
+            max_radius,
+            kernel: s.kernel,
+        };
+        (
+            lookup(global),
+            lookup(s.caustic_max_radius.unwrap_or(global / 4.0)),
+        )
+    }
+}
+
+/// The wavelengths every photon and camera sample of pass `pass` of
+/// `passes` carries: the offset u is jittered in stratum `pass` of [0, 1).
+pub fn pass_wavelengths(seed: u64, pass: u32, passes: u32) -> SampledWavelengths {
+    let mut rng = Pcg32::new(hash_u64s(&[seed, u64::from(pass), 0x1A3B_DA00]), 0);
+    let u = (pass as f32 + rng.uniform_f32()) / passes as f32;
+    SampledWavelengths::sample_visible(u.min(1.0 - f32::EPSILON / 2.0))
+}
+
+/// Renders one camera sample per pixel for `pass`, tile by tile in parallel;
+/// the tiles come back in scanline order.
+fn render_pass(
+    walk: &CameraWalk<'_>,
+    ctx: &RenderContext<'_>,
+    film: &RgbFilm,
+    pass: u32,
+    lambda: &SampledWavelengths,
+) -> Vec<FilmTile> {
+    driver::tiles(film.pixel_bounds())
+        .into_par_iter()
+        .map(|(lo, hi)| {
+            let mut tile = film.tile(lo, hi);
+            let mut sampler = ctx.sampler.clone();
+            let mut scratch = Vec::new();
+            for y in lo.y..hi.y {
+                for x in lo.x..hi.x {
+                    let pixel = UVec2::new(x, y);
+                    sampler.start_pixel_sample(pixel, pass, 0);
+                    // The driver's camera sample, with the pass wavelengths
+                    // replacing the ones it draws (that draw keeps the sampler
+                    // dimensions aligned with the other integrators').
+                    let Some(mut cs) = driver::camera_sample(ctx, film, pixel, &mut sampler) else {
+                        continue;
+                    };
+                    cs.lambda = *lambda;
+                    let l = walk.li(cs.ray, &mut cs.lambda, &mut sampler, &mut scratch);
+                    tile.add_sample(pixel, l * cs.ray_weight, &cs.lambda, cs.filter_weight);
+                }
+            }
+            tile
+        })
+        .collect()
+}
