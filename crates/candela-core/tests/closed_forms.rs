@@ -310,3 +310,29 @@ fn t4d_lossless_diffuse_transmitter_vanishes_under_uniform_sky() {
     let img = render_str(&scene, &bdpt(128));
     assert_region(&img, (10, 22, 10, 22), 1.0, 2e-3, "T4d transmitter, BDPT");
 }
+
+#[test]
+fn t7_spherical_camera_inside_an_emitting_sphere_sees_its_radiance_everywhere() {
+    // A black, emitting (L = 2) sphere around a spherical camera: every
+    // direction sees 2, for both mappings, through PT and BDPT (whose t = 1
+    // strategies are dropped for a camera without importance).
+    for (mapping, res) in [("equalarea", (16, 16)), ("equirectangular", (24, 12))] {
+        let scene = format!(
+            r#"LookAt 0 0 0  0 0 1  0 1 0
+Camera "spherical" "string mapping" "{mapping}"
+Film "rgb" "integer xresolution" [{}] "integer yresolution" [{}]
+Sampler "independent"
+WorldBegin
+AreaLightSource "diffuse" "rgb L" [2 2 2]
+Material "diffuse" "rgb reflectance" [0 0 0]
+ReverseOrientation
+Shape "sphere" "float radius" [3]
+"#,
+            res.0, res.1
+        );
+        let img = render_str(&scene, &ov(16));
+        assert_region(&img, (0, res.0, 0, res.1), 2.0, 4e-3, "spherical PT");
+        let img = render_str(&scene, &bdpt(16));
+        assert_region(&img, (0, res.0, 0, res.1), 2.0, 4e-3, "spherical BDPT");
+    }
+}

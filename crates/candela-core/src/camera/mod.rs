@@ -27,11 +27,13 @@
 
 mod orthographic;
 mod perspective;
+mod spherical;
 #[cfg(test)]
 mod tests;
 
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
+pub use spherical::{SphericalCamera, SphericalMapping};
 
 use crate::interaction::Interaction;
 use crate::math::{Ray, Transform, UVec2, Vec2, Vec3};
@@ -132,6 +134,8 @@ pub enum Camera {
     Perspective(PerspectiveCamera),
     /// Orthographic camera (optionally thin-lens).
     Orthographic(OrthographicCamera),
+    /// Every direction around a point (no importance function).
+    Spherical(SphericalCamera),
 }
 
 macro_rules! dispatch {
@@ -139,6 +143,18 @@ macro_rules! dispatch {
         match $self {
             Camera::Perspective($c) => $e,
             Camera::Orthographic($c) => $e,
+            Camera::Spherical($c) => $e,
+        }
+    };
+}
+
+/// The projective cameras only (the spherical one has no W_e).
+macro_rules! dispatch_projective {
+    ($self:ident, $c:ident => $e:expr, $none:expr) => {
+        match $self {
+            Camera::Perspective($c) => $e,
+            Camera::Orthographic($c) => $e,
+            Camera::Spherical(_) => $none,
         }
     };
 }
@@ -161,7 +177,7 @@ impl Camera {
 
     /// Importance W_e of the ray (o, d) and the raster position it maps to.
     pub fn we(&self, ray_o: Vec3, ray_d: Vec3) -> (f32, Option<Vec2>) {
-        dispatch!(self, c => c.we(ray_o, ray_d))
+        dispatch_projective!(self, c => c.we(ray_o, ray_d), (0.0, None))
     }
 
     /// Densities of the ray's origin (area on the lens) and direction.
@@ -171,15 +187,21 @@ impl Camera {
 
     /// Samples a lens point seen from `ref_p` and the importance arriving there.
     pub fn sample_wi(&self, ref_p: &Interaction, u: Vec2) -> Option<CameraWiSample> {
-        dispatch!(self, c => c.sample_wi(ref_p, u))
+        dispatch_projective!(self, c => c.sample_wi(ref_p, u), None)
     }
 
     /// True when directional importance is a delta (light paths cannot hit it).
     pub fn is_delta_direction(&self) -> bool {
         match self {
-            Camera::Perspective(_) => false,
+            Camera::Perspective(_) | Camera::Spherical(_) => false,
             Camera::Orthographic(c) => c.is_delta_direction(),
         }
+    }
+
+    /// True when light paths can be connected to the camera (t = 1
+    /// strategies): projective cameras whose importance is not a delta.
+    pub fn is_connectable(&self) -> bool {
+        !self.is_delta_direction() && !matches!(self, Camera::Spherical(_))
     }
 
     /// World-space transform from camera space.

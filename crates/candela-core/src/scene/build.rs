@@ -112,6 +112,11 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let (integrator, integrator_name, power_sampling) =
         entities::integrator(desc, ov, &outfile, &mut warnings)?;
+    if integrator_name == "lightpath" && !camera.is_connectable() {
+        return Err(BuildError::Other(
+            "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
+        ));
+    }
     let (materials, names, textures_used) = materials::materials(desc)?;
     let (primitives, mut lights) = geometry::primitives(desc, &names)?;
     lights.extend(lights::lights(desc)?);

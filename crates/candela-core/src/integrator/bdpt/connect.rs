@@ -150,7 +150,7 @@ fn connect_camera<'a>(
 ) -> Option<(Unweighted, PathView<'a>)> {
     let v = &light[s - 1];
     let u = sampler.get_2d();
-    if cx.camera.is_delta_direction() {
+    if !cx.camera.is_connectable() {
         return None;
     }
     let f_hat = match v.kind {

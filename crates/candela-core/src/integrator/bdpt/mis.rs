@@ -165,7 +165,7 @@ pub(crate) fn strategy_valid(
         return false;
     }
     if k == n - 1 {
-        if camera.is_delta_direction() {
+        if !camera.is_connectable() {
             return false;
         }
         if k == 1 {

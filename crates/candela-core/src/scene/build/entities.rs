@@ -1,7 +1,7 @@
 //! Camera, film, pixel filter, sampler and integrator from their directives.
 
 use super::{BuildError, Overrides};
-use crate::camera::{Camera, CameraParams};
+use crate::camera::{Camera, CameraParams, SphericalCamera, SphericalMapping};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{FilmSettings, RgbFilm};
 use crate::integrator::photonmap::Kernel;
@@ -196,11 +196,35 @@ pub fn camera(desc: &SceneDescription, film: &RgbFilm) -> Result<Camera, BuildEr
             Camera::perspective(&params)
         }
         "orthographic" => Camera::orthographic(&params),
+        "spherical" => {
+            let mapping = match p.get_string("mapping", "equalarea")?.as_str() {
+                "equalarea" => SphericalMapping::EqualArea,
+                "equirectangular" => SphericalMapping::Equirectangular,
+                other => {
+                    return Err(BuildError::at(
+                        p.param_loc("mapping").unwrap_or(&c.loc),
+                        format!("unknown spherical mapping \"{other}\" (expected \"equalarea\" or \"equirectangular\")"),
+                    ))
+                }
+            };
+            let res = film.resolution();
+            if mapping == SphericalMapping::EqualArea && res.x != res.y {
+                return Err(BuildError::at(
+                    &c.loc,
+                    format!("the equal-area spherical camera needs a square film, found {}×{}", res.x, res.y),
+                ));
+            }
+            Ok(Camera::Spherical(SphericalCamera::new(
+                params.camera_from_world,
+                res,
+                mapping,
+            )))
+        }
         other => {
             return Err(BuildError::at(
                 &c.loc,
                 format!(
-                "camera \"{other}\" is not supported yet (supported: perspective, orthographic)"
+                "camera \"{other}\" is not supported yet (supported: perspective, orthographic, spherical)"
             ),
             ))
         }
