@@ -4,12 +4,14 @@
 /// χ² goodness-of-fit harness for direction samplers (test support).
 pub mod chi2;
 mod distribution;
+mod equal_area;
 mod hash;
 mod pdf;
 mod rng;
 mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
+pub use equal_area::{equal_area_sphere_to_square, equal_area_square_to_sphere};
 pub use hash::{hash_u64s, mix_bits, murmur_hash64a};
 pub use pdf::{pdf_area_to_solid_angle, pdf_solid_angle_to_area, PdfArea, PdfSolidAngle};
 pub use rng::Pcg32;
