@@ -8,6 +8,7 @@
 mod coated;
 mod entities;
 mod geometry;
+mod image_textures;
 mod lights;
 mod materials;
 mod shapes;
@@ -107,7 +108,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let (integrator, integrator_name, power_sampling) =
         entities::integrator(desc, ov, &outfile, &mut warnings)?;
-    let (materials, names, textures_used) = materials::materials(desc)?;
+    let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
     let (primitives, mut lights) = geometry::primitives(desc, &names)?;
     lights.extend(lights::lights(desc)?);
     let scene = Scene::new(primitives, materials, lights, power_sampling);

@@ -222,8 +222,10 @@ impl ColorSpace {
     /// The tabulated RGB → spectrum fit for per-lookup conversions (image
     /// textures and maps), built on first use (see `rgb2spec_table`).
     pub fn rgb_table(&self) -> &RgbToSpectrumTable {
-        self.table
-            .get_or_init(|| RgbToSpectrumTable::build(self, TABLE_RES))
+        self.table.get_or_init(|| {
+            let on_worker = rayon::current_thread_index().is_some();
+            RgbToSpectrumTable::build(self, TABLE_RES, !on_worker)
+        })
     }
 
     /// The spectrum of `rgb` read with meaning `kind`, at the path's

@@ -29,7 +29,10 @@
 //! exact-grey case of the lookup makes black itself exact.
 //!
 //! **Cost.** The table is built on first use, per colour space, in parallel
-//! (rayon over columns) and kept for the process: `res` = 64 as in pbrt-v4,
+//! (rayon over columns; serially when first needed on a rayon worker, where a
+//! nested parallel build could steal a job that waits for the table) and
+//! kept for the process. Scene loading asks for it while building image
+//! textures and lights, so renders never wait for it: `res` = 64 as in pbrt-v4,
 //! 3·64³ ≈ 786k fits, about 2 s of one core (≈ 2.5M residual evaluations).
 //! The round-trip RGB error of interpolated coefficients is measured in the
 //! tests: 1.2·10⁻³ worst over random colours (exact fit: 7·10⁻⁶); 32 nodes
@@ -64,22 +67,25 @@ fn smoothstep(t: f64) -> f64 {
 }
 
 impl RgbToSpectrumTable {
-    /// Fits the table for colour space `cs` at `res` nodes per axis (≥ 4).
-    pub fn build(cs: &ColorSpace, res: usize) -> Self {
+    /// Fits the table for colour space `cs` at `res` nodes per axis (≥ 4),
+    /// on rayon's pool when `parallel`.
+    pub fn build(cs: &ColorSpace, res: usize, parallel: bool) -> Self {
         assert!(res >= 4, "table resolution {res} too small");
         let w = binned_weights(&spectral_weights(cs));
         let z_nodes: Vec<f64> = (0..res)
             .map(|k| smoothstep(smoothstep(k as f64 / (res - 1) as f64)))
             .collect();
-        // One chain of fits per (l, y, x) column, in parallel.
-        let columns: Vec<Vec<[f64; 3]>> = (0..3 * res * res)
-            .into_par_iter()
-            .map(|c| {
-                let (l, j, i) = (c / (res * res), (c / res) % res, c % res);
-                let (x, y) = (i as f64 / (res - 1) as f64, j as f64 / (res - 1) as f64);
-                fit_column(l, x, y, &z_nodes, &w)
-            })
-            .collect();
+        // One chain of fits per (l, y, x) column.
+        let column = |c: usize| {
+            let (l, j, i) = (c / (res * res), (c / res) % res, c % res);
+            let (x, y) = (i as f64 / (res - 1) as f64, j as f64 / (res - 1) as f64);
+            fit_column(l, x, y, &z_nodes, &w)
+        };
+        let columns: Vec<Vec<[f64; 3]>> = if parallel {
+            (0..3 * res * res).into_par_iter().map(column).collect()
+        } else {
+            (0..3 * res * res).map(column).collect()
+        };
         let mut coeffs = vec![[0.0f32; 3]; 3 * res * res * res];
         for (c, col) in columns.iter().enumerate() {
             let (l, j, i) = (c / (res * res), (c / res) % res, c % res);
