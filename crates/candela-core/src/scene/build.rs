@@ -110,7 +110,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         entities::integrator(desc, ov, &outfile, &mut warnings)?;
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
     let (primitives, mut lights) = geometry::primitives(desc, &names)?;
-    lights.extend(lights::lights(desc)?);
+    lights.extend(lights::lights(desc, &mut warnings)?);
     let scene = Scene::new(primitives, materials, lights, power_sampling);
     collect_unused(desc, &textures_used, &mut warnings);
     Ok(RenderSetup {
