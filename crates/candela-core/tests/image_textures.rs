@@ -75,9 +75,9 @@ Material "diffuse" "texture reflectance" "t""#,
         64,
     );
     for (q, t) in QUADRANTS.iter().zip(texels) {
-        for c in 0..3 {
+        for (c, &code) in t.iter().enumerate() {
             let (m, se) = common::region_mean(&img, c, q.0, q.1, q.2, q.3);
-            let want = srgb(t[c]);
+            let want = srgb(code);
             eprintln!("quadrant {q:?} channel {c}: {m:.4} ± {se:.4}, texel {want:.4}");
             assert!(
                 (m - want).abs() <= 5.0 * se + 0.01,

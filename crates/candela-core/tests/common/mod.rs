@@ -35,6 +35,7 @@ pub fn render_at(text: &str, path: &Path, ov: &Overrides) -> (RgbImage, Vec<Stri
 /// Mean and standard error of the mean of channel `c` over pixels in `[x0,x1)×[y0,y1)`.
 /// Pixels are independent estimates (each reseeds its sampler), so the
 /// standard error is the pixel standard deviation / √n.
+#[allow(dead_code)] // Not every test crate measures regions.
 pub fn region_mean(
     img: &RgbImage,
     c: usize,
@@ -54,6 +55,7 @@ pub fn region_mean(
 }
 
 /// Asserts `|mean − expected| ≤ 5σ + b` for every channel of the region (validation.md's rule).
+#[allow(dead_code)] // Not every test crate measures regions.
 pub fn assert_region(
     img: &RgbImage,
     region: (usize, usize, usize, usize),

@@ -10,12 +10,13 @@
 
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
-use crate::image::{read_map, ColorEncoding};
+use crate::image::{read_map, ColorEncoding, MapImage};
 use crate::light::{self as create, Light};
 use crate::math::{Transform, Vec3};
 use crate::shape::Shape;
 use crate::spectrum::{ColorSpace, Spectrum};
 use candela_scene::{Entity, LightDesc, Loc, SceneDescription};
+use std::path::Path;
 use std::sync::Arc;
 
 fn cs(name: &str, loc: &Loc) -> Result<&'static ColorSpace, BuildError> {
@@ -146,38 +147,52 @@ fn infinite(
         ));
     }
     let loc = p.param_loc("filename").unwrap_or(&d.loc);
+    let (im, color_space) = env_map(&path, loc, warnings)?;
+    Ok(Light::ImageInfinite(create::image_infinite_light(
+        t,
+        Arc::new(im),
+        color_space,
+        scale,
+        illuminance,
+    )))
+}
+
+/// An equal-area environment map: a square, finite RGB image.
+fn env_map(
+    path: &Path,
+    loc: &Loc,
+    warnings: &mut Vec<String>,
+) -> Result<(MapImage, &'static ColorSpace), BuildError> {
+    let name = path.display();
     if !path.is_file() {
         return Err(BuildError::at(
             loc,
-            format!("image file \"{}\" not found", path.display()),
+            format!("image file \"{name}\" not found"),
         ));
     }
     let file =
-        read_map(&path, ColorEncoding::Srgb).map_err(|e| BuildError::at(loc, e.to_string()))?;
+        read_map(path, ColorEncoding::Srgb).map_err(|e| BuildError::at(loc, e.to_string()))?;
     if let Some(w) = file.warning {
         warnings.push(format!("{loc}: {w}"));
     }
     let im = file.image;
-    let name = path.display();
+    let fail = |msg: String| Err(BuildError::at(loc, format!("{name}: {msg}")));
     if im.channels != 3 {
-        return Err(BuildError::at(
-            loc,
-            format!("{name}: image provided to \"infinite\" light must have R, G, and B channels"),
-        ));
+        return fail("image provided to \"infinite\" light must have R, G, and B channels".into());
     }
     if im.width != im.height {
-        return Err(BuildError::at(loc, format!("{name}: image resolution ({}, {}) is non-square; it is unlikely to be an equal-area environment map", im.width, im.height)));
+        return fail(format!(
+            "image resolution ({}, {}) is non-square; it is unlikely to be an equal-area environment map",
+            im.width, im.height
+        ));
     }
     if im.data.iter().any(|v| !v.is_finite()) {
-        return Err(BuildError::at(loc, format!("{name}: image has infinite or not-a-number pixel values and so is not suitable as a light")));
+        return fail(
+            "image has infinite or not-a-number pixel values and so is not suitable as a light"
+                .into(),
+        );
     }
     // Fit the RGB table now rather than on the first lookup, mid-render.
     file.color_space.rgb_table();
-    Ok(Light::ImageInfinite(create::image_infinite_light(
-        t,
-        Arc::new(im),
-        file.color_space,
-        scale,
-        illuminance,
-    )))
+    Ok((im, file.color_space))
 }
