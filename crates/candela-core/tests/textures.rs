@@ -228,15 +228,15 @@ Material "conductor" "texture roughness" "a""#,
 }
 
 #[test]
-fn image_textures_are_reported_unsupported_where_declared() {
+fn missing_image_files_are_reported_at_the_filename() {
     let text = scene(
         r#"Texture "img" "spectrum" "imagemap" "string filename" "wood.png"
 Material "diffuse" "texture reflectance" "img""#,
         8,
     );
     let e = build_error(&text);
-    assert!(e.starts_with(&loc_of(&text, "Texture \"img\"")), "{e}");
-    assert!(e.contains("unsupported texture 'imagemap'"), "{e}");
+    assert!(e.starts_with(&loc_of(&text, "\"string filename\"")), "{e}");
+    assert!(e.contains("wood.png\" not found"), "{e}");
     // Unreferenced, it is only a warning.
     let text = scene(
         r#"Texture "img" "spectrum" "imagemap" "string filename" "wood.png""#,

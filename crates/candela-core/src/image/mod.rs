@@ -1,9 +1,16 @@
-//! RGB float images: EXR and PNG files, and the comparison metrics of
-//! `candela diff` (validation.md, "Image metrics").
+//! Images: RGB float images (the film's EXR and PNG output and the
+//! comparison metrics of `candela diff`, validation.md "Image metrics"), and
+//! map images read for textures and environment lights ([`MapImage`]).
 
 mod compare;
+mod map;
+mod read;
+mod resize;
 
 pub use compare::{compare, Comparison};
+pub use map::{MapImage, PixelFormat, WrapMode};
+pub use read::{read_map, ColorEncoding, MapFile};
+pub use resize::resize_to_power_of_two;
 
 use std::path::Path;
 use thiserror::Error;
@@ -26,6 +33,14 @@ pub enum ImageError {
         path: String,
         /// Cause.
         source: image::ImageError,
+    },
+    /// The file is not a map candela can read.
+    #[error("{path}: {msg}")]
+    Format {
+        /// File.
+        path: String,
+        /// What is wrong.
+        msg: String,
     },
     /// The two images cannot be compared.
     #[error("image sizes differ: {0}x{1} vs {2}x{3}")]

@@ -15,19 +15,32 @@
 //! | diffuse area | `power` Φ_v > 0 | Φ_v / (π·A·(2 if two-sided else 1)) |
 //! | distant | `illuminance` E_v > 0 | E_v (pbrt-v4 after issue #130; was E_v/(−w.y)) |
 //! | uniform infinite | `illuminance` E_v > 0 | E_v / π (illuminance on an upward patch) |
+//! | image infinite | `illuminance` E_v > 0 | E_v / k, k = (2π/N)·Σ_{texels with z > 0} Y(rgb)·cos θ |
 //!
 //! Non-positive `power`/`illuminance` (pbrt's default −1) means "not given":
 //! pass `None` or a value ≤ 0. pbrt-v4's area-light `k_e` is left
 //! uninitialised when `L` is a spectrum rather than an image; we use its
 //! evident intent, k_e = 1 before the geometric factor. Renders with these
 //! values reproduce pbrt-v4's pixel values.
+//!
+//! An image infinite light normalises by its colour space's illuminant (its
+//! texels are RGB illuminant spectra) and, for `illuminance`, by pbrt-v4's
+//! estimate k of the map's illuminance on a patch facing light-space +z:
+//! N texels of 4π/N sr each, Y the luminance row of the colour space. The
+//! true Riemann sum has 4π/N where pbrt-v4 (`lights.cpp`, `Light::Create`)
+//! has 2π/N, so k is half the map's illuminance and the light renders 2·E_v
+//! on that patch; candela keeps pbrt-v4's factor so scenes render alike.
 
 use super::{
-    spectrum_photometric, DiffuseAreaLight, DistantLight, LightSpectrum, PointLight, SpotLight,
-    UniformInfiniteLight,
+    spectrum_photometric, DiffuseAreaLight, DistantLight, ImageInfiniteLight, LightSpectrum,
+    PointLight, SpotLight, UniformInfiniteLight,
 };
-use crate::math::{Frame, Mat4, Transform, Vec3, PI};
+use crate::image::MapImage;
+use crate::math::{Frame, Mat4, Transform, Vec2, Vec3, PI};
+use crate::sampling::equal_area_square_to_sphere;
 use crate::shape::Shape;
+use crate::spectrum::ColorSpace;
+use std::sync::Arc;
 
 /// `scale / SpectrumToPhotometric(s)`: normalises `s` to one nit [pbrt-v4].
 fn nit_scale(scale: f32, s: &LightSpectrum) -> f32 {
@@ -146,4 +159,44 @@ pub fn uniform_infinite_light(
         sc *= e_v / PI;
     }
     UniformInfiniteLight::new(l, sc)
+}
+
+/// pbrt-v4 `"infinite"` with an equal-area `filename` image (square, RGB) in
+/// colour space `cs`; optional `illuminance` (lx) on a light-space +z patch,
+/// with pbrt-v4's normalisation (see the module doc).
+pub fn image_infinite_light(
+    render_from_light: &Transform,
+    image: Arc<MapImage>,
+    cs: &'static ColorSpace,
+    scale: f32,
+    illuminance: Option<f32>,
+) -> ImageInfiniteLight {
+    let mut sc = nit_scale(scale, &cs.illuminant);
+    if let Some(e_v) = given(illuminance) {
+        let k = map_illuminance_pbrt(&image, cs);
+        if k > 0.0 {
+            sc *= e_v / k;
+        }
+    }
+    ImageInfiniteLight::new(*render_from_light, image, cs, sc)
+}
+
+/// pbrt-v4's illuminance estimate of an equal-area map on a +z patch:
+/// (2π/N)·Σ_{z > 0} Y(rgb)·z over texel centres.
+fn map_illuminance_pbrt(image: &MapImage, cs: &ColorSpace) -> f32 {
+    let lum = cs.xyz_from_rgb.row(1);
+    let (w, h) = (image.width, image.height);
+    let mut sum = 0.0f64;
+    for y in 0..h {
+        for x in 0..w {
+            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let d = equal_area_square_to_sphere(uv);
+            if d.z <= 0.0 {
+                continue;
+            }
+            let t = &image.data[(y * w + x) * 3..][..3];
+            sum += (lum.dot(Vec3::new(t[0], t[1], t[2])) * d.z) as f64;
+        }
+    }
+    (sum * 2.0 * std::f64::consts::PI / (w * h) as f64) as f32
 }

@@ -36,6 +36,7 @@ mod create;
 mod diffuse_area;
 mod distant;
 mod emission;
+mod image_infinite;
 mod infinite;
 mod point;
 mod sampler;
@@ -45,11 +46,13 @@ mod spot;
 mod tests;
 
 pub use create::{
-    diffuse_area_light, distant_light, point_light, spot_light, uniform_infinite_light,
+    diffuse_area_light, distant_light, image_infinite_light, point_light, spot_light,
+    uniform_infinite_light,
 };
 pub use diffuse_area::DiffuseAreaLight;
 pub use distant::DistantLight;
 pub use emission::{spectrum_photometric, LightSpectrum};
+pub use image_infinite::ImageInfiniteLight;
 pub use infinite::UniformInfiniteLight;
 pub use point::PointLight;
 pub use sampler::LightSampler;
@@ -187,6 +190,8 @@ pub enum Light {
     DiffuseArea(DiffuseAreaLight),
     /// Constant radiance from every direction at infinity.
     UniformInfinite(UniformInfiniteLight),
+    /// Radiance at infinity from an equal-area environment image.
+    ImageInfinite(ImageInfiniteLight),
 }
 
 /// Writes the dispatch `match` over every light once.
@@ -198,6 +203,7 @@ macro_rules! dispatch {
             Light::Distant($l) => $body,
             Light::DiffuseArea($l) => $body,
             Light::UniformInfinite($l) => $body,
+            Light::ImageInfinite($l) => $body,
         }
     };
 }
@@ -209,7 +215,7 @@ impl Light {
             Light::Point(_) | Light::Spot(_) => LightType::DeltaPosition,
             Light::Distant(_) => LightType::DeltaDirection,
             Light::DiffuseArea(_) => LightType::Area,
-            Light::UniformInfinite(_) => LightType::Infinite,
+            Light::UniformInfinite(_) | Light::ImageInfinite(_) => LightType::Infinite,
         }
     }
 
@@ -229,6 +235,7 @@ impl Light {
         match self {
             Light::DiffuseArea(l) => l.pdf_li(ctx, wi),
             Light::UniformInfinite(l) => l.pdf_li(ctx, wi),
+            Light::ImageInfinite(l) => l.pdf_li(ctx, wi),
             _ => PdfSolidAngle(0.0),
         }
     }
@@ -254,6 +261,7 @@ impl Light {
     pub fn le(&self, ray: &Ray, lambda: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Light::UniformInfinite(l) => l.le(ray, lambda),
+            Light::ImageInfinite(l) => l.le(ray, lambda),
             _ => SampledSpectrum::zero(),
         }
     }
@@ -277,6 +285,7 @@ impl Light {
             Light::Spot(l) => l.pdf_le(ray),
             Light::Distant(l) => l.pdf_le(ray),
             Light::UniformInfinite(l) => l.pdf_le(ray),
+            Light::ImageInfinite(l) => l.pdf_le(ray),
             Light::DiffuseArea(_) => {
                 debug_assert!(false, "pdf_le on an area light: use pdf_le_area");
                 (PdfArea(0.0), PdfSolidAngle(0.0))
@@ -303,6 +312,7 @@ impl Light {
         match self {
             Light::Distant(l) => l.preprocess(scene_bounds),
             Light::UniformInfinite(l) => l.preprocess(scene_bounds),
+            Light::ImageInfinite(l) => l.preprocess(scene_bounds),
             _ => {}
         }
     }

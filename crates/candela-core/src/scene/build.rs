@@ -8,6 +8,7 @@
 mod coated;
 mod entities;
 mod geometry;
+mod image_textures;
 mod lights;
 mod materials;
 mod shapes;
@@ -117,9 +118,9 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
             "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
         ));
     }
-    let (materials, names, textures_used) = materials::materials(desc)?;
+    let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
     let (primitives, mut lights) = geometry::primitives(desc, &names)?;
-    lights.extend(lights::lights(desc)?);
+    lights.extend(lights::lights(desc, &mut warnings)?);
     let scene = Scene::new(primitives, materials, lights, power_sampling);
     collect_unused(desc, &textures_used, &mut warnings);
     Ok(RenderSetup {

@@ -1,8 +1,9 @@
 //! Colour: RGB and XYZ triples, RGB colour spaces, and the pixel sensor.
 
 use super::rgb2spec::{fit_sigmoid, RgbSigmoidPolynomial};
+use super::rgb2spec_table::{RgbToSpectrumTable, TABLE_RES};
 use super::spectra::{spectrum_to_xyz, PiecewiseLinear, Spectrum};
-use super::{cie_xyz, named, SampledSpectrum, SampledWavelengths};
+use super::{cie_xyz, named, SampledSpectrum, SampledWavelengths, SpectrumKind};
 use glam::{Mat3, Vec3};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -103,6 +104,7 @@ pub struct ColorSpace {
     /// Linear RGB from XYZ.
     pub rgb_from_xyz: Mat3,
     cache: Mutex<HashMap<[u32; 3], RgbSigmoidPolynomial>>,
+    table: OnceLock<RgbToSpectrumTable>,
 }
 
 impl std::fmt::Debug for ColorSpace {
@@ -136,6 +138,7 @@ impl ColorSpace {
             xyz_from_rgb,
             rgb_from_xyz: xyz_from_rgb.inverse(),
             cache: Mutex::new(HashMap::new()),
+            table: OnceLock::new(),
         }
     }
 
@@ -214,6 +217,47 @@ impl ColorSpace {
             c.insert(key, p);
         }
         p
+    }
+
+    /// The tabulated RGB → spectrum fit for per-lookup conversions (image
+    /// textures and maps), built on first use (see `rgb2spec_table`).
+    pub fn rgb_table(&self) -> &RgbToSpectrumTable {
+        self.table.get_or_init(|| {
+            let on_worker = rayon::current_thread_index().is_some();
+            RgbToSpectrumTable::build(self, TABLE_RES, !on_worker)
+        })
+    }
+
+    /// The spectrum of `rgb` read with meaning `kind`, at the path's
+    /// wavelengths, through the table [pbrt-v4 `RGBAlbedoSpectrum`,
+    /// `RGBUnboundedSpectrum`, `RGBIlluminantSpectrum`]: albedos are clamped
+    /// to [0, 1]³; other kinds are s(λ) of rgb/(2m) scaled by 2m, m the largest
+    /// component (× the illuminant for emission). Negative components count as 0.
+    pub fn sample_rgb(
+        &self,
+        rgb: Rgb,
+        kind: SpectrumKind,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let table = self.rgb_table();
+        let rgb = Rgb::new(rgb.r.max(0.0), rgb.g.max(0.0), rgb.b.max(0.0));
+        if kind == SpectrumKind::Albedo {
+            let p = table.coeffs(rgb);
+            return SampledSpectrum::from_fn(|i| p.eval(lambda.lambda(i)));
+        }
+        let scale = 2.0 * rgb.r.max(rgb.g).max(rgb.b);
+        if scale == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        let p = table.coeffs(Rgb::new(rgb.r / scale, rgb.g / scale, rgb.b / scale));
+        SampledSpectrum::from_fn(|i| {
+            let l = lambda.lambda(i);
+            let v = scale * p.eval(l);
+            match kind {
+                SpectrumKind::Illuminant => v * self.illuminant_table.eval(l),
+                _ => v,
+            }
+        })
     }
 }
 

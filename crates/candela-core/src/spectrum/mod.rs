@@ -12,15 +12,18 @@ mod color;
 mod data;
 mod named;
 mod rgb2spec;
+mod rgb2spec_table;
 mod sampled;
 mod spectra;
 
 pub use color::{ColorSpace, PixelSensor, Rgb, Xyz};
 pub use named::named_spectrum;
 pub use rgb2spec::RgbSigmoidPolynomial;
+pub use rgb2spec_table::{RgbToSpectrumTable, TABLE_RES};
 pub use sampled::*;
 pub use spectra::{
     inner_product, planck, spectrum_to_photometric, spectrum_to_xyz, PiecewiseLinear, Spectrum,
+    SpectrumKind,
 };
 
 /// Σ ȳ(λ) over 360–830 nm at 1 nm: the normaliser of XYZ (pbrt-v4's `CIE_Y_integral`).

@@ -77,7 +77,7 @@ impl RgbSigmoidPolynomial {
 const N: usize = 471;
 
 /// Per-wavelength RGB weights: rgb = Σ_λ w(λ) s(λ) for an albedo s under the illuminant.
-fn weights(cs: &ColorSpace) -> Vec<[f64; 3]> {
+pub(super) fn spectral_weights(cs: &ColorSpace) -> Vec<[f64; 3]> {
     let ill: Vec<f64> = (0..N)
         .map(|i| cs.illuminant.eval(LAMBDA_MIN + i as f32) as f64)
         .collect();
@@ -175,7 +175,7 @@ fn gauss_newton(mut c: [f64; 3], target: [f64; 3], w: &[[f64; 3]]) -> [f64; 3] {
 
 /// Fits the sigmoid polynomial of an RGB in [0,1]³ for colour space `cs`.
 pub fn fit_sigmoid(cs: &ColorSpace, rgb: Rgb) -> RgbSigmoidPolynomial {
-    let w = weights(cs);
+    let w = spectral_weights(cs);
     let target = [rgb.r as f64, rgb.g as f64, rgb.b as f64];
     let mean = (target[0] + target[1] + target[2]) / 3.0;
     let mut c = [

@@ -71,6 +71,17 @@ impl PiecewiseLinear {
     }
 }
 
+/// How an RGB value is lifted to a spectrum [pbrt-v4 `SpectrumType`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SpectrumKind {
+    /// Reflectances in [0, 1].
+    Albedo,
+    /// Any non-negative value (η, k, scattering coefficients).
+    Unbounded,
+    /// Emission: RGB × the colour space's illuminant.
+    Illuminant,
+}
+
 /// A spectral distribution: emission, reflectance or index of refraction.
 #[derive(Clone, Debug)]
 pub enum Spectrum {

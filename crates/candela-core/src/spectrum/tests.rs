@@ -187,3 +187,35 @@ fn blackbody_is_normalised_to_its_peak() {
     assert!((b.eval(peak) - 1.0).abs() < 1e-4);
     assert!(b.eval(peak - 30.0) < 1.0 && b.eval(peak + 30.0) < 1.0);
 }
+
+#[test]
+fn rgb_table_round_trips_random_colours() {
+    let cs = ColorSpace::srgb();
+    let t0 = std::time::Instant::now();
+    let table = cs.rgb_table();
+    eprintln!("sRGB table built (or found) in {:.2?}", t0.elapsed());
+    let mut r = Pcg32::new(11, 3);
+    let (mut worst, mut worst_exact) = (0.0f32, 0.0f32);
+    for i in 0..400 {
+        // Random colours, plus dark and saturated ones.
+        let mut c = [r.uniform_f32(), r.uniform_f32(), r.uniform_f32()];
+        if i % 4 == 1 {
+            c = c.map(|v| 0.02 * v);
+        } else if i % 4 == 2 {
+            c[i % 3] *= 0.05;
+        }
+        let rgb = Rgb::new(c[0], c[1], c[2]);
+        let s = Spectrum::RgbAlbedo(table.coeffs(rgb));
+        let back = albedo_rgb(cs, &s);
+        let exact = albedo_rgb(cs, &Spectrum::rgb_albedo(cs, rgb));
+        for k in 0..3 {
+            worst = worst.max((back[k] - c[k]).abs());
+            worst_exact = worst_exact.max((exact[k] - c[k]).abs());
+        }
+    }
+    eprintln!("worst |Δrgb| table {worst:.2e}, exact fit {worst_exact:.2e}");
+    assert!(worst < 2e-3, "table round trip off by {worst}");
+    // Greys are exact.
+    let g = Spectrum::RgbAlbedo(table.coeffs(Rgb::new(0.3, 0.3, 0.3)));
+    assert!((g.eval(500.0) - 0.3).abs() < 1e-6);
+}

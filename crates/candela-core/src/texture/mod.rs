@@ -3,8 +3,8 @@
 //! The set and semantics follow pbrt-v4 (`textures.h`, `textures.cpp`,
 //! `util/noise.cpp`; book §10.2–10.6): `constant`, `scale`, `mix`,
 //! `directionmix`, `checkerboard` (2D and 3D), `bilerp`, `dots`, `fbm`,
-//! `wrinkled`, `windy` (float only) and `marble` (spectrum only). Image
-//! textures are not implemented yet.
+//! `wrinkled`, `windy` (float only), `marble` (spectrum only) and `imagemap`
+//! ([`ImageTexture`], PNG and EXR files).
 //!
 //! A texture is evaluated at a [`TextureEvalContext`] taken from the hit:
 //! position, normal, (u, v) and their screen-space derivatives. A mapping
@@ -21,6 +21,7 @@
 //! (reflectance or unbounded, pbrt-v4's `SpectrumType`); the scene builder
 //! builds a texture once per meaning it is used with.
 
+mod image;
 mod mapping;
 mod marble;
 mod nodes;
@@ -29,6 +30,7 @@ mod perm;
 #[cfg(test)]
 mod tests;
 
+pub use image::{ImageFilter, ImageTexture, SpectrumImageTexture};
 pub use mapping::{TexCoord2D, TexCoord3D, TextureMapping2D, TextureMapping3D};
 pub use marble::{marble_rgb, marble_spectrum, Marble};
 pub use nodes::{
@@ -103,6 +105,8 @@ pub enum FloatTexture {
     Wrinkled(Arc<NoiseSum>),
     /// `windy`.
     Windy(Arc<TextureMapping3D>),
+    /// `imagemap`.
+    Image(Arc<ImageTexture>),
 }
 
 impl FloatTexture {
@@ -120,6 +124,7 @@ impl FloatTexture {
             FloatTexture::Fbm(n) => n.fbm(ctx),
             FloatTexture::Wrinkled(n) => n.turbulence(ctx),
             FloatTexture::Windy(m) => nodes::windy(m, ctx),
+            FloatTexture::Image(t) => t.evaluate_float(ctx),
         }
     }
 
@@ -151,6 +156,8 @@ pub enum SpectrumTexture {
     Dots(Arc<Dots<SpectrumTexture>>),
     /// `marble`.
     Marble(Arc<Marble>),
+    /// `imagemap`.
+    Image(Arc<SpectrumImageTexture>),
 }
 
 impl SpectrumTexture {
@@ -170,6 +177,7 @@ impl SpectrumTexture {
             SpectrumTexture::Bilerp(n) => n.eval(ctx, |s| s.sample(lambda)),
             SpectrumTexture::Dots(n) => n.eval(ctx, f),
             SpectrumTexture::Marble(n) => n.eval(ctx, lambda),
+            SpectrumTexture::Image(t) => t.evaluate(ctx, lambda),
         }
     }
 }

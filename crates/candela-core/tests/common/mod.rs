@@ -12,8 +12,15 @@ use candela_core::scene::build::{build, Overrides};
 use std::path::Path;
 
 /// Renders pbrt-v4 scene text with the given overrides; asserts no sample was dropped.
+#[allow(dead_code)] // Not every test crate renders from text alone.
 pub fn render_str(text: &str, ov: &Overrides) -> RgbImage {
-    let desc = candela_scene::parse_str(text, Path::new("test.pbrt")).expect("scene parses");
+    render_at(text, Path::new("test.pbrt"), ov).0
+}
+
+/// Renders scene text as if read from `path` (relative files resolve beside
+/// it); returns the image and the build warnings.
+pub fn render_at(text: &str, path: &Path, ov: &Overrides) -> (RgbImage, Vec<String>) {
+    let desc = candela_scene::parse_str(text, path).expect("scene parses");
     let mut setup = build(&desc, ov).expect("scene builds");
     let ctx = RenderContext {
         scene: &setup.scene,
@@ -27,12 +34,13 @@ pub fn render_str(text: &str, ov: &Overrides) -> RgbImage {
         0,
         "non-finite samples were produced"
     );
-    setup.film.image()
+    (setup.film.image(), setup.warnings)
 }
 
 /// Mean and standard error of the mean of channel `c` over pixels in `[x0,x1)×[y0,y1)`.
 /// Pixels are independent estimates (each reseeds its sampler), so the
 /// standard error is the pixel standard deviation / √n.
+#[allow(dead_code)] // Not every test crate measures regions.
 pub fn region_mean(
     img: &RgbImage,
     c: usize,
@@ -52,6 +60,7 @@ pub fn region_mean(
 }
 
 /// Asserts `|mean − expected| ≤ 5σ + b` for every channel of the region (validation.md's rule).
+#[allow(dead_code)] // Not every test crate measures regions.
 pub fn assert_region(
     img: &RgbImage,
     region: (usize, usize, usize, usize),

@@ -7,6 +7,7 @@
 
 mod chi2;
 mod fixtures;
+mod image_infinite;
 mod irradiance;
 mod power;
 

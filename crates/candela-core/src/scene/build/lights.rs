@@ -1,12 +1,23 @@
 //! `LightSource` and `AreaLightSource` directives.
+//!
+//! `"infinite"` follows pbrt-v4's `Light::Create`: without `L` and
+//! `filename`, a uniform sky of the colour space's illuminant; with `L`, a
+//! uniform sky of that spectrum; with `filename`, an equal-area square RGB
+//! image (PNG or EXR, relative to the scene file); both is an error. A
+//! `portal` is ignored with a warning: pbrt-v4's `PortalImageInfiniteLight`
+//! samples only directions through the portal and shows the sky only there,
+//! which renders the same wherever the portal is the scene's only opening.
 
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
+use crate::image::{read_map, ColorEncoding, MapImage};
 use crate::light::{self as create, Light};
 use crate::math::{Transform, Vec3};
 use crate::shape::Shape;
 use crate::spectrum::{ColorSpace, Spectrum};
-use candela_scene::{Entity, Loc, SceneDescription};
+use candela_scene::{Entity, LightDesc, Loc, SceneDescription};
+use std::path::Path;
+use std::sync::Arc;
 
 fn cs(name: &str, loc: &Loc) -> Result<&'static ColorSpace, BuildError> {
     ColorSpace::by_name(name)
@@ -58,11 +69,14 @@ pub fn area_light(a: &Entity, shape: &Shape, shape_loc: &Loc) -> Result<Light, B
 }
 
 /// All `LightSource` lights.
-pub fn lights(desc: &SceneDescription) -> Result<Vec<Light>, BuildError> {
-    desc.lights.iter().map(light).collect()
+pub fn lights(
+    desc: &SceneDescription,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Light>, BuildError> {
+    desc.lights.iter().map(|d| light(d, warnings)).collect()
 }
 
-fn light(d: &candela_scene::LightDesc) -> Result<Light, BuildError> {
+fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError> {
     let p = &d.params;
     let t = Transform::from_rows_f64(d.render_from_light.m)
         .ok_or_else(|| BuildError::at(&d.loc, "singular light transform"))?;
@@ -95,15 +109,90 @@ fn light(d: &candela_scene::LightDesc) -> Result<Light, BuildError> {
             v3("from", Vec3::ZERO)?,
             v3("to", Vec3::Z)?,
         )),
-        "infinite" => {
-            if p.get_filename("filename")?.is_some() {
-                return Err(BuildError::at(&d.loc, "image-based \"infinite\" lights (\"filename\") are not supported yet"));
-            }
-            if p.get_point3s("portal")?.is_some() {
-                return Err(BuildError::at(&d.loc, "\"portal\" is not supported yet"));
-            }
-            Light::UniformInfinite(create::uniform_infinite_light(illum("L")?, scale, optional_positive(p.get_float("illuminance", -1.0)?)))
-        }
+        "infinite" => infinite(d, &t, space, scale, warnings)?,
         other => return Err(BuildError::at(&d.loc, format!("light \"{other}\" is not supported yet (supported: point, spot, distant, infinite)"))),
     })
+}
+
+/// pbrt-v4 `"infinite"`: uniform (`L` or the illuminant) or image (`filename`).
+fn infinite(
+    d: &LightDesc,
+    t: &Transform,
+    space: &'static ColorSpace,
+    scale: f32,
+    warnings: &mut Vec<String>,
+) -> Result<Light, BuildError> {
+    let p = &d.params;
+    let l = spectrum_param(p, "L", SpectrumKind::Illuminant, space)?;
+    let file = p.get_filename("filename")?;
+    let illuminance = optional_positive(p.get_float("illuminance", -1.0)?);
+    if p.get_point3s("portal")?.is_some() {
+        warnings.push(format!(
+            "{}: \"portal\" ignored: candela samples the environment over the whole sphere and shows it in every direction (the same image where the portal is the only opening)",
+            p.param_loc("portal").unwrap_or(&d.loc)
+        ));
+    }
+    let Some(path) = file else {
+        let l = l.unwrap_or_else(|| space.illuminant.clone());
+        return Ok(Light::UniformInfinite(create::uniform_infinite_light(
+            l,
+            scale,
+            illuminance,
+        )));
+    };
+    if l.is_some() {
+        return Err(BuildError::at(
+            &d.loc,
+            "can't specify both emission \"L\" and \"filename\" for an \"infinite\" light",
+        ));
+    }
+    let loc = p.param_loc("filename").unwrap_or(&d.loc);
+    let (im, color_space) = env_map(&path, loc, warnings)?;
+    Ok(Light::ImageInfinite(create::image_infinite_light(
+        t,
+        Arc::new(im),
+        color_space,
+        scale,
+        illuminance,
+    )))
+}
+
+/// An equal-area environment map: a square, finite RGB image.
+fn env_map(
+    path: &Path,
+    loc: &Loc,
+    warnings: &mut Vec<String>,
+) -> Result<(MapImage, &'static ColorSpace), BuildError> {
+    let name = path.display();
+    if !path.is_file() {
+        return Err(BuildError::at(
+            loc,
+            format!("image file \"{name}\" not found"),
+        ));
+    }
+    let file =
+        read_map(path, ColorEncoding::Srgb).map_err(|e| BuildError::at(loc, e.to_string()))?;
+    if let Some(w) = file.warning {
+        warnings.push(format!("{loc}: {w}"));
+    }
+    let im = file.image;
+    let fail = |msg: String| Err(BuildError::at(loc, format!("{name}: {msg}")));
+    if im.channels != 3 {
+        return fail("image provided to \"infinite\" light must have R, G, and B channels".into());
+    }
+    if im.width != im.height {
+        return fail(format!(
+            "image resolution ({}, {}) is non-square; it is unlikely to be an equal-area environment map",
+            im.width, im.height
+        ));
+    }
+    if im.data.iter().any(|v| !v.is_finite()) {
+        return fail(
+            "image has infinite or not-a-number pixel values and so is not suitable as a light"
+                .into(),
+        );
+    }
+    // Fit the RGB table now rather than on the first lookup, mid-render.
+    file.color_space.rgb_table();
+    Ok((im, file.color_space))
 }

@@ -23,6 +23,7 @@ pub type MaterialNames = (HashMap<String, MaterialId>, MaterialId);
 /// All materials, the name table, and which `Texture` directives they used.
 pub fn materials(
     desc: &SceneDescription,
+    warnings: &mut Vec<String>,
 ) -> Result<(Vec<Material>, MaterialNames, Vec<bool>), BuildError> {
     let first_named = desc.materials.len();
     let names: HashMap<String, MaterialId> = desc
@@ -49,6 +50,7 @@ pub fn materials(
         displacement: None,
     });
     let used = textures.used().to_vec();
+    warnings.extend_from_slice(textures.warnings());
     Ok((out, (names, default), used))
 }
 

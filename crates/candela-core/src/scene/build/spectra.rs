@@ -5,16 +5,7 @@ use super::BuildError;
 use crate::spectrum::{named_spectrum, ColorSpace, Rgb, Spectrum};
 use candela_scene::{ParamSet, ParamSpectrum, SpectrumValue};
 
-/// How an RGB parameter is lifted to a spectrum [pbrt-v4 `SpectrumType`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SpectrumKind {
-    /// Reflectances in [0, 1].
-    Albedo,
-    /// Any non-negative value (η, k, scattering coefficients).
-    Unbounded,
-    /// Emission: RGB × the colour space's illuminant.
-    Illuminant,
-}
+pub use crate::spectrum::SpectrumKind;
 
 /// Reads spectrum parameter `name` of `params`, if present.
 pub fn spectrum_param(

@@ -90,6 +90,7 @@ fn light_kind(l: &Light) -> &'static str {
         Light::Distant(_) => "distant",
         Light::DiffuseArea(_) => "diffuse area",
         Light::UniformInfinite(_) => "infinite (uniform)",
+        Light::ImageInfinite(_) => "infinite (image)",
     }
 }
 

@@ -15,13 +15,14 @@
 //! unbounded ones. Nested textures inherit the meaning of their user.
 //! Parameter names and defaults are pbrt-v4's (`textures.cpp`, `Create`).
 
+use super::image_textures::ImageCache;
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
 use crate::math::{Transform, Vec3};
 use crate::spectrum::{ColorSpace, Spectrum};
 use crate::texture::{
     Bilerp, CheckerMap, Checkerboard, DirectionMix, Dots, FloatTexture, Marble, Mix, NoiseSum,
-    Scale, SpectrumTexture, TextureMapping2D, TextureMapping3D,
+    Scale, SpectrumImageTexture, SpectrumTexture, TextureMapping2D, TextureMapping3D,
 };
 use candela_scene::{Loc, ParamSet, TextureDesc, TextureKind};
 use std::collections::HashMap;
@@ -65,12 +66,13 @@ pub struct Textures<'a> {
     floats: HashMap<usize, FloatTexture>,
     spectra: HashMap<(usize, SpectrumKind), SpectrumTexture>,
     used: Vec<bool>,
+    images: ImageCache,
 }
 
 const FLOAT_CLASSES: &str =
-    "constant, scale, mix, directionmix, checkerboard, bilerp, dots, fbm, wrinkled, windy";
+    "constant, scale, mix, directionmix, checkerboard, bilerp, dots, fbm, wrinkled, windy, imagemap";
 const SPECTRUM_CLASSES: &str =
-    "constant, scale, mix, directionmix, checkerboard, bilerp, dots, marble";
+    "constant, scale, mix, directionmix, checkerboard, bilerp, dots, marble, imagemap";
 
 impl<'a> Textures<'a> {
     /// Indexes the scene's `Texture` directives by name and kind.
@@ -90,7 +92,13 @@ impl<'a> Textures<'a> {
             floats: HashMap::new(),
             spectra: HashMap::new(),
             used: vec![false; descs.len()],
+            images: ImageCache::default(),
         }
+    }
+
+    /// Non-fatal problems met while building (image filters, colour spaces).
+    pub fn warnings(&self) -> &[String] {
+        &self.images.warnings
     }
 
     /// Which textures were referenced (directly or through other textures).
@@ -257,6 +265,7 @@ impl<'a> Textures<'a> {
             "fbm" => FloatTexture::Fbm(Arc::new(noise_sum(d)?)),
             "wrinkled" => FloatTexture::Wrinkled(Arc::new(noise_sum(d)?)),
             "windy" => FloatTexture::Windy(Arc::new(mapping_3d(d)?)),
+            "imagemap" => FloatTexture::Image(Arc::new(self.images.texture(d)?)),
             other => return Err(unsupported(d, other, "float", FLOAT_CLASSES)),
         };
         self.floats.insert(i, t.clone());
@@ -318,6 +327,10 @@ impl<'a> Textures<'a> {
                 scale: p.get_float("scale", 1.0)?,
                 variation: p.get_float("variation", 0.2)?,
             })),
+            "imagemap" => SpectrumTexture::Image(Arc::new(SpectrumImageTexture {
+                tex: self.images.texture(d)?,
+                kind,
+            })),
             other => return Err(unsupported(d, other, "spectrum", SPECTRUM_CLASSES)),
         };
         self.spectra.insert((i, kind), t.clone());
@@ -328,12 +341,10 @@ impl<'a> Textures<'a> {
 /// The error for a texture class candela does not build.
 fn unsupported(d: &TextureDesc, class: &str, kind: &str, known: &str) -> BuildError {
     let msg = match class {
-        "imagemap" | "ptex" => {
-            format!(
-                "unsupported texture '{class}' (\"{}\"): image textures are not implemented yet",
-                d.name
-            )
-        }
+        "ptex" => format!(
+            "unsupported texture 'ptex' (\"{}\"): Ptex files are not supported yet",
+            d.name
+        ),
         _ => format!(
             "unknown {kind} texture type \"{class}\" for \"{}\" (supported: {known})",
             d.name
@@ -363,7 +374,7 @@ fn texture_from_render(d: &TextureDesc) -> Result<Transform, BuildError> {
 }
 
 /// The 2D mapping from `"string mapping"` and its parameters [pbrt-v4 `TextureMapping2D::Create`].
-fn mapping_2d(d: &TextureDesc) -> Result<TextureMapping2D, BuildError> {
+pub(super) fn mapping_2d(d: &TextureDesc) -> Result<TextureMapping2D, BuildError> {
     let p = &d.params;
     Ok(match p.get_string("mapping", "uv")?.as_str() {
         "uv" => TextureMapping2D::Uv {

@@ -1,0 +1,127 @@
+//! `imagemap` textures: parameters, file loading and a cache of loaded images.
+//!
+//! Parameters and defaults are pbrt-v4's (`FloatImageTexture::Create`,
+//! `SpectrumImageTexture::Create`): `filename` (relative to the scene file's
+//! directory), `filter` (`bilinear`; `point`; `trilinear` and `ewa` evaluate
+//! as bilinear — with a warning — because candela has no ray differentials),
+//! `maxanisotropy` (EWA only, so unused), `wrap` (`repeat`, `black`, `clamp`,
+//! `octahedralsphere`), `scale`, `invert`, `encoding` (`sRGB` for `.png`
+//! files, else `linear`; or `gamma γ`) and the 2D mapping. As in pbrt-v4's
+//! texture cache, a file is loaded (and resized to power-of-two sides) once
+//! per wrap mode and encoding, however many textures and meanings use it.
+
+use super::textures::mapping_2d;
+use super::BuildError;
+use crate::image::{read_map, resize_to_power_of_two, ColorEncoding, MapImage, WrapMode};
+use crate::spectrum::ColorSpace;
+use crate::texture::{ImageFilter, ImageTexture};
+use candela_scene::TextureDesc;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A loaded image and its colour space.
+type Loaded = (Arc<MapImage>, &'static ColorSpace);
+
+/// Images loaded so far, by file, wrap mode and encoding.
+#[derive(Default)]
+pub struct ImageCache {
+    loaded: HashMap<(PathBuf, WrapMode, String), Loaded>,
+    /// Non-fatal problems met while loading or reading parameters.
+    pub warnings: Vec<String>,
+}
+
+impl ImageCache {
+    /// The lookup of `imagemap` texture `d`.
+    pub fn texture(&mut self, d: &TextureDesc) -> Result<ImageTexture, BuildError> {
+        let p = &d.params;
+        let loc_of = |n: &str| p.param_loc(n).unwrap_or(&d.loc);
+        let Some(path) = p.get_filename("filename")? else {
+            return Err(BuildError::at(
+                &d.loc,
+                format!("imagemap texture \"{}\" needs a \"filename\"", d.name),
+            ));
+        };
+        let filter = match p.get_string("filter", "bilinear")?.as_str() {
+            "bilinear" => ImageFilter::Bilinear,
+            "point" => ImageFilter::Point,
+            f @ ("trilinear" | "ewa") => {
+                self.warnings.push(format!(
+                    "{}: filter \"{f}\" of texture \"{}\" evaluates as \"bilinear\": candela traces no ray differentials",
+                    loc_of("filter"), d.name
+                ));
+                ImageFilter::Bilinear
+            }
+            other => {
+                return Err(BuildError::at(
+                    loc_of("filter"),
+                    format!(
+                    "unknown texture filter \"{other}\" (known: bilinear, point, trilinear, ewa)"
+                ),
+                ))
+            }
+        };
+        // Only EWA uses it; read so that it is not reported as unused.
+        let _ = p.get_float("maxanisotropy", 8.0)?;
+        let wrap_name = p.get_string("wrap", "repeat")?;
+        let wrap = WrapMode::parse(&wrap_name).ok_or_else(|| {
+            BuildError::at(
+                loc_of("wrap"),
+                format!("unknown wrap mode \"{wrap_name}\" (known: repeat, black, clamp, octahedralsphere)"),
+            )
+        })?;
+        let is_png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let enc_name = p.get_string("encoding", if is_png { "sRGB" } else { "linear" })?;
+        let encoding = ColorEncoding::parse(&enc_name).ok_or_else(|| {
+            BuildError::at(
+                loc_of("encoding"),
+                format!("unknown color encoding \"{enc_name}\" (known: linear, sRGB, \"gamma <value>\")"),
+            )
+        })?;
+        let (image, color_space) =
+            self.load(path, wrap, &enc_name, encoding, loc_of("filename"))?;
+        Ok(ImageTexture {
+            map: mapping_2d(d)?,
+            image,
+            wrap,
+            filter,
+            scale: p.get_float("scale", 1.0)?,
+            invert: p.get_bool("invert", false)?,
+            color_space,
+        })
+    }
+
+    /// The image at `path` resized for `wrap`, loaded on first request.
+    fn load(
+        &mut self,
+        path: PathBuf,
+        wrap: WrapMode,
+        enc_name: &str,
+        encoding: ColorEncoding,
+        loc: &candela_scene::Loc,
+    ) -> Result<Loaded, BuildError> {
+        let key = (path, wrap, enc_name.to_string());
+        if let Some(l) = self.loaded.get(&key) {
+            return Ok(l.clone());
+        }
+        let path = &key.0;
+        if !path.is_file() {
+            return Err(BuildError::at(
+                loc,
+                format!("image file \"{}\" not found", path.display()),
+            ));
+        }
+        let file = read_map(path, encoding).map_err(|e| BuildError::at(loc, e.to_string()))?;
+        if let Some(w) = file.warning {
+            self.warnings.push(format!("{loc}: {w}"));
+        }
+        let image = Arc::new(resize_to_power_of_two(&file.image, wrap));
+        // Fit the RGB table now rather than on the first lookup, mid-render.
+        file.color_space.rgb_table();
+        let l = (image, file.color_space);
+        self.loaded.insert(key, l.clone());
+        Ok(l)
+    }
+}

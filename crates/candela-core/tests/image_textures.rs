@@ -1,0 +1,152 @@
+//! `imagemap` textures end to end: PNG files written at test time, resolved
+//! relative to the scene file, on a diffuse quad that fills an orthographic
+//! view under a uniform white sky. With nothing else in the scene, a diffuse
+//! surface under a uniform sky of radiance 1 reflects exactly its albedo
+//! (validation.md T4(d)), so each pixel reads the texel's RGB (direct
+//! lighting only: `maxdepth` 1). Tolerance: 5σ of the region mean plus
+//! b = 0.01 for the spectral round trip of the RGB (table fit, 4-wavelength
+//! film).
+
+mod common;
+
+use candela_core::scene::build::Overrides;
+use common::{assert_region, render_at};
+use std::path::{Path, PathBuf};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("candela-imgtex-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Linear value of an 8-bit sRGB code.
+fn srgb(b: u8) -> f64 {
+    let v = b as f64 / 255.0;
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn quad_scene(world: &str) -> String {
+    format!(
+        r#"LookAt 0 0 -3  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" [16] "integer yresolution" [16]
+PixelFilter "box"
+Sampler "independent"
+Integrator "path" "integer maxdepth" [1]
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+{world}
+Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]
+    "point2 uv" [0 0  1 0  1 1  0 1] "integer indices" [0 1 2  0 2 3]
+"#
+    )
+}
+
+fn render(dir: &Path, world: &str, spp: u32) -> (candela_core::image::RgbImage, Vec<String>) {
+    let ov = Overrides {
+        spp: Some(spp),
+        seed: Some(7),
+        ..Default::default()
+    };
+    render_at(&quad_scene(world), &dir.join("scene.pbrt"), &ov)
+}
+
+/// The inner 6×6 pixels of each 8×8 quadrant: top-left, top-right, bottom-left, bottom-right.
+const QUADRANTS: [(usize, usize, usize, usize); 4] =
+    [(1, 7, 1, 7), (9, 15, 1, 7), (1, 7, 9, 15), (9, 15, 9, 15)];
+
+#[test]
+fn rgb_image_appears_upright_with_its_texel_colours() {
+    let dir = temp_dir("rgb");
+    let texels: [[u8; 3]; 4] = [[200, 60, 40], [40, 190, 70], [50, 60, 210], [128, 128, 128]];
+    let raw: Vec<u8> = texels.iter().flatten().copied().collect();
+    image::RgbImage::from_raw(2, 2, raw)
+        .unwrap()
+        .save(dir.join("tex.png"))
+        .unwrap();
+    let (img, _) = render(
+        &dir,
+        r#"Texture "t" "spectrum" "imagemap" "string filename" "tex.png" "string filter" "point"
+Material "diffuse" "texture reflectance" "t""#,
+        64,
+    );
+    for (q, t) in QUADRANTS.iter().zip(texels) {
+        for (c, &code) in t.iter().enumerate() {
+            let (m, se) = common::region_mean(&img, c, q.0, q.1, q.2, q.3);
+            let want = srgb(code);
+            eprintln!("quadrant {q:?} channel {c}: {m:.4} ± {se:.4}, texel {want:.4}");
+            assert!(
+                (m - want).abs() <= 5.0 * se + 0.01,
+                "{q:?} c{c}: {m} vs {want}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn float_image_scales_inverts_and_reads_the_first_channel() {
+    let dir = temp_dir("float");
+    // Red channel 0 on the left column, 204 on the right; green and blue are ignored.
+    let raw = vec![0, 255, 255, 204, 0, 0, 0, 255, 255, 204, 0, 0];
+    image::RgbImage::from_raw(2, 2, raw)
+        .unwrap()
+        .save(dir.join("f.png"))
+        .unwrap();
+    let (img, warnings) = render(
+        &dir,
+        r#"Texture "f" "float" "imagemap" "string filename" "f.png" "string filter" "ewa"
+    "string encoding" "linear" "float scale" [0.5] "bool invert" true "string wrap" "clamp"
+Texture "r" "spectrum" "scale" "rgb tex" [1 1 1] "texture scale" "f"
+Material "diffuse" "texture reflectance" "r""#,
+        64,
+    );
+    // 1 − 0.5·v: 1 on the left, 1 − 0.5·0.8 = 0.6 on the right, outside the
+    // bilinear ramp between the texel centres s = 1/4 and s = 3/4.
+    assert_region(&img, (0, 4, 0, 16), 1.0, 0.01, "left");
+    assert_region(&img, (12, 16, 0, 16), 0.6, 0.01, "right");
+    let (mid, _) = common::region_mean(&img, 1, 7, 9, 0, 16);
+    assert!((mid - 0.8).abs() < 0.05, "ramp midpoint {mid}");
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("\"ewa\"") && w.contains("bilinear")),
+        "{warnings:?}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn non_power_of_two_images_and_unbounded_spectra_render() {
+    let dir = temp_dir("npot");
+    image::RgbImage::from_pixel(3, 5, image::Rgb([90, 150, 210]))
+        .save(dir.join("c.png"))
+        .unwrap();
+    let (img, _) = render(
+        &dir,
+        r#"Texture "c" "spectrum" "imagemap" "string filename" "c.png"
+Material "diffuse" "texture reflectance" "c""#,
+        32,
+    );
+    for (c, b) in [90u8, 150, 210].into_iter().enumerate() {
+        let (m, se) = common::region_mean(&img, c, 1, 15, 1, 15);
+        assert!(
+            (m - srgb(b)).abs() <= 5.0 * se + 0.01,
+            "c{c}: {m} vs {}",
+            srgb(b)
+        );
+    }
+    // The same file as η and k of a conductor (unbounded RGB): finite.
+    let (img, _) = render(
+        &dir,
+        r#"Texture "c" "spectrum" "imagemap" "string filename" "c.png" "float scale" [3]
+Material "conductor" "texture eta" "c" "texture k" "c" "float roughness" [0.3]"#,
+        4,
+    );
+    assert!(img.pixels.iter().flatten().all(|v| v.is_finite()));
+    std::fs::remove_dir_all(&dir).ok();
+}
