@@ -336,3 +336,38 @@ Shape "sphere" "float radius" [3]
         assert_region(&img, (0, res.0, 0, res.1), 2.0, 4e-3, "spherical BDPT");
     }
 }
+
+#[test]
+fn alpha_cut_outs_let_camera_and_shadow_rays_through() {
+    // validation.md T7 behind a black sheet: α = 0 hides the sheet (2), α = ½
+    // lets half the rays through (1), a texture of α = 0/1 checks too (1).
+    for (alpha, expected) in [
+        ("\"float alpha\" [0]", 2.0),
+        ("\"float alpha\" [0.5]", 1.0),
+        ("\"texture alpha\" \"checks\"", 1.0),
+    ] {
+        let scene = emitter_scene("path").replace(
+            "WorldBegin\n",
+            &format!(
+                "WorldBegin\nTexture \"checks\" \"float\" \"checkerboard\" \"float uscale\" [8] \"float vscale\" [8] \"float tex1\" [1] \"float tex2\" [0]\nAttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nShape \"trianglemesh\" \"point3 P\" [-5 -5 2  5 -5 2  5 5 2  -5 5 2] \"integer indices\" [0 1 2 0 2 3] \"point2 uv\" [0 0 1 0 1 1 0 1] {alpha}\nAttributeEnd\n"
+            ),
+        );
+        assert!(scene.contains("alpha"));
+        let img = render_str(&scene, &ov(64));
+        assert_region(&img, (0, 24, 0, 16), expected, 2e-3 * expected, alpha);
+    }
+    // Shadow rays: T4b's centred point light (L = 1 on the wall) with a
+    // fully cut-out sphere around the light still gives 1.
+    let scene = sphere_scene([0.0; 3], std::f32::consts::PI, 1.0, 60.0).replace(
+        "ReverseOrientation\n",
+        "AttributeBegin\nShape \"sphere\" \"float radius\" [0.5] \"float alpha\" [0]\nAttributeEnd\nReverseOrientation\n",
+    );
+    let img = render_str(&scene, &ov(16));
+    assert_region(
+        &img,
+        (0, 32, 0, 32),
+        1.0,
+        2e-3,
+        "T4b behind an α = 0 sphere",
+    );
+}

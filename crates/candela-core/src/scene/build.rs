@@ -119,7 +119,12 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         ));
     }
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
-    let (primitives, mut lights) = geometry::primitives(desc, &names)?;
+    let (primitives, mut lights, alpha_used) = geometry::primitives(desc, &names)?;
+    let textures_used: Vec<bool> = textures_used
+        .iter()
+        .zip(&alpha_used)
+        .map(|(a, b)| *a || *b)
+        .collect();
     lights.extend(lights::lights(desc, &mut warnings)?);
     let scene = Scene::new(primitives, materials, lights, power_sampling);
     collect_unused(desc, &textures_used, &mut warnings);

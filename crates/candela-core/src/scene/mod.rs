@@ -101,9 +101,11 @@ impl Scene {
         let mut best = None;
         let wr = WatertightRay::new(ray);
         self.bvh.intersect(ray, t_max, |i, ray, t_max| {
-            let hit = self.primitives[i as usize]
-                .shape
-                .intersect_deferred(ray, &wr, t_max)?;
+            let prim = &self.primitives[i as usize];
+            let hit = prim.shape.intersect_deferred(ray, &wr, t_max)?;
+            if prim.alpha.is_some() && !prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray) {
+                return None;
+            }
             let t = hit.t();
             best = Some((i, hit));
             Some(t)
@@ -118,8 +120,16 @@ impl Scene {
 
     /// True if anything blocks `ray` before `t_max`.
     pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
+        let wr = WatertightRay::new(ray);
         self.bvh.intersect_p(ray, t_max, |i, ray, t_max| {
-            self.primitives[i as usize].shape.intersect_p(ray, t_max)
+            let prim = &self.primitives[i as usize];
+            if prim.alpha.is_none() {
+                return prim.shape.intersect_p(ray, t_max);
+            }
+            match prim.shape.intersect_deferred(ray, &wr, t_max) {
+                Some(hit) => prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray),
+                None => false,
+            }
         })
     }
 

@@ -12,4 +12,35 @@ pub struct Primitive {
     pub material: Option<MaterialId>,
     /// Emission.
     pub area_light: Option<LightId>,
+    /// Cut-out mask (`None`: opaque) [pbrt-v4 `GeometricPrimitive`].
+    pub alpha: Option<crate::texture::FloatTexture>,
+}
+
+impl Primitive {
+    /// pbrt-v4's alpha test at a candidate hit: kept when α ≥ 1, dropped when
+    /// α ≤ 0, otherwise kept with probability α using a hash of the ray (so a
+    /// ray and its shadow-ray twin decide alike, and images stay deterministic).
+    pub fn alpha_passes(
+        &self,
+        si: crate::interaction::SurfaceInteraction,
+        ray: &crate::math::Ray,
+    ) -> bool {
+        let Some(alpha) = &self.alpha else {
+            return true;
+        };
+        let a = alpha.evaluate(&crate::texture::TextureEvalContext::from_si(&si));
+        if a >= 1.0 {
+            return true;
+        }
+        if a <= 0.0 {
+            return false;
+        }
+        let bits = |v: crate::math::Vec3| {
+            ((v.x.to_bits() as u64) << 32 | v.y.to_bits() as u64)
+                ^ (v.z.to_bits() as u64).rotate_left(17)
+        };
+        let h = crate::sampling::hash_u64s(&[bits(ray.o), bits(ray.d)]);
+        let u = (h >> 40) as f32 / (1u64 << 24) as f32;
+        u < a
+    }
 }

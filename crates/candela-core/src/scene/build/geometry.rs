@@ -3,22 +3,30 @@
 use super::lights::area_light;
 use super::materials::MaterialNames;
 use super::shapes::build_shape;
+use super::textures::{Source, Textures};
 use super::BuildError;
 use crate::interaction::{LightId, MaterialId};
 use crate::light::Light;
 use crate::math::Transform;
 use crate::scene::Primitive;
+use crate::texture::FloatTexture;
 use candela_scene::{MaterialRef, SceneDescription, ShapeDesc};
 
-/// All primitives (instances flattened) and the area lights they carry.
+/// Primitives, their area lights, and the `Texture` directives alpha used.
+pub type Built = (Vec<Primitive>, Vec<Light>, Vec<bool>);
+
+/// All primitives (instances flattened), the area lights they carry, and
+/// which `Texture` directives their `alpha` parameters used.
 pub fn primitives(
     desc: &SceneDescription,
     names: &MaterialNames,
-) -> Result<(Vec<Primitive>, Vec<Light>), BuildError> {
+) -> Result<Built, BuildError> {
     let mut prims = Vec::new();
     let mut lights = Vec::new();
+    let mut tex = Textures::new(&desc.textures);
+    let tex = &mut tex;
     for s in &desc.shapes {
-        add_shape(s, &Transform::IDENTITY, names, &mut prims, &mut lights)?;
+        add_shape(s, &Transform::IDENTITY, names, tex, &mut prims, &mut lights)?;
     }
     for inst in &desc.instances {
         let def = desc
@@ -37,16 +45,18 @@ pub fn primitives(
             if let Some(a) = &s.area_light {
                 return Err(BuildError::at(&a.loc, "area lights inside object instances are not supported (pbrt-v4 rejects them too)"));
             }
-            add_shape(s, &t, names, &mut prims, &mut lights)?;
+            add_shape(s, &t, names, tex, &mut prims, &mut lights)?;
         }
     }
-    Ok((prims, lights))
+    let used = tex.used().to_vec();
+    Ok((prims, lights, used))
 }
 
 fn add_shape(
     s: &ShapeDesc,
     parent: &Transform,
     names: &MaterialNames,
+    tex: &mut Textures,
     prims: &mut Vec<Primitive>,
     lights: &mut Vec<Light>,
 ) -> Result<(), BuildError> {
@@ -57,20 +67,7 @@ fn add_shape(
         })?),
         MaterialRef::None => Some(names.1),
     };
-    if let Some(a) = s.params.get_floats("alpha")? {
-        if a.first().is_some_and(|&v| v != 1.0) {
-            return Err(BuildError::at(
-                &s.loc,
-                "\"alpha\" cut-outs are not supported yet",
-            ));
-        }
-    }
-    if let Some(t) = s.params.get_texture("alpha") {
-        return Err(BuildError::at(
-            &s.loc,
-            format!("alpha texture \"{t}\" is not supported yet"),
-        ));
-    }
+    let alpha = alpha(s, tex)?;
     let object = Transform::from_rows_f64(s.render_from_object.m)
         .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
     let render_from_object = parent.then_after(&object);
@@ -88,7 +85,26 @@ fn add_shape(
             shape,
             material,
             area_light,
+            alpha: alpha.clone(),
         });
     }
     Ok(())
+}
+
+/// pbrt-v4's `alpha` (float or float texture): `None` when the shape is
+/// fully opaque. Emitters with cut-outs are rejected (their emission would
+/// have to be masked too).
+fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Option<FloatTexture>, BuildError> {
+    let src = Source::new(&s.params, &s.loc, "srgb")?;
+    let alpha = match tex.float_opt(&src, "alpha")? {
+        Some(FloatTexture::Constant(a)) if a >= 1.0 => None,
+        other => other,
+    };
+    if alpha.is_some() && s.area_light.is_some() {
+        return Err(BuildError::at(
+            s.params.param_loc("alpha").unwrap_or(&s.loc),
+            "\"alpha\" on an area light is not supported yet",
+        ));
+    }
+    Ok(alpha)
 }
