@@ -6,8 +6,9 @@
 //!   PLY meshes; the reference is pbrt-v4's BDPT): the path tracer within
 //!   3 % in two regions it converges (the lit back floor and the spot's
 //!   pool; it cannot render the caustic), BDPT within 2 % over the whole
-//!   image and within 5 % in the caustic below the glass; SPPM within 5 %
-//!   in the caustic (rendered through a crop window over it).
+//!   image and within 5 % in the caustic below the glass; SPPM, PPM and
+//!   the photon map within 5 % in the caustic (rendered through a crop
+//!   window over it).
 //!
 //! Each bound is the stated relative tolerance plus 5σ of the rendered
 //! mean. Every scene is rendered twice with different seeds; the estimate
@@ -129,29 +130,28 @@ fn caustic_glass_bdpt_matches_pbrt_v4_bdpt() {
     assert_close(&img, &reference, [120, 200, 260, 330], 0.05, "caustic");
 }
 
-#[test]
-fn caustic_glass_sppm_matches_pbrt_v4_in_the_caustic() {
-    // The caustic region [120, 260) × [200, 330) through a crop window; four
-    // seeds of 8 iterations × 200 000 photons. SPPM's pixels share photons,
-    // so σ of the region mean comes from the spread over the seeds.
+/// Mean luma of the caustic region [120, 260) × [200, 330) rendered through
+/// a crop window by a photon integrator, over `seeds` seeds; returns the mean
+/// and its standard error from the spread over seeds (the pixels of one
+/// render share its photons and wavelengths, so they are not independent).
+fn caustic_region(integrator: &str, params: &str, seeds: u64, spp: u32) -> (f64, f64) {
     let dir = scene_dir("caustic-glass");
     let text = std::fs::read_to_string(dir.join("scene.pbrt")).expect("scene");
     let text = text
         .replace(
             "Integrator \"bdpt\"",
-            "Integrator \"sppm\" \"float radius\" [0.03] \"integer photonsperiteration\" [200000]",
+            &format!("Integrator \"{integrator}\" {params}"),
         )
         .replace(
             "Film \"rgb\"",
             "Film \"rgb\" \"float cropwindow\" [0.342857 0.742857 0.4 0.66]",
         );
-    assert!(text.contains("sppm") && text.contains("cropwindow"));
+    assert!(text.contains(integrator) && text.contains("cropwindow"));
     let desc = candela_scene::parse_str(&text, &dir.join("scene.pbrt")).expect("parses");
-    let region = [120, 200, 260, 330];
-    let means: Vec<f64> = (0..4)
+    let means: Vec<f64> = (0..seeds)
         .map(|seed| {
             let ov = Overrides {
-                spp: Some(8),
+                spp: Some(spp),
                 seed: Some(seed),
                 ..Default::default()
             };
@@ -170,17 +170,38 @@ fn caustic_glass_sppm_matches_pbrt_v4_in_the_caustic() {
             pixels(full).map(|(x, y)| luma(&img, x, y)).sum::<f64>() / (140.0 * 130.0)
         })
         .collect();
-    let m = means.iter().sum::<f64>() / 4.0;
-    let se = (means.iter().map(|v| (v - m).powi(2)).sum::<f64>() / 3.0 / 4.0).sqrt();
+    let n = seeds as f64;
+    let m = means.iter().sum::<f64>() / n;
+    let se = (means.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    (m, se)
+}
+
+fn assert_caustic(integrator: &str, (m, se): (f64, f64)) {
+    let dir = scene_dir("caustic-glass");
     let reference =
         RgbImage::read_exr(&dir.join("reference-pbrt-v4-bdpt-1024spp.exr")).expect("ref");
+    let region = [120, 200, 260, 330];
     let mr = pixels(region)
         .map(|(x, y)| luma(&reference, x, y))
         .sum::<f64>()
         / pixels(region).count() as f64;
     eprintln!(
-        "SPPM caustic: {m:.5} ± {se:.5} vs pbrt-v4 {mr:.5} (ratio {:.4})",
+        "{integrator} caustic: {m:.5} ± {se:.5} vs pbrt-v4 {mr:.5} (ratio {:.4})",
         m / mr
     );
-    assert!((m - mr).abs() <= 0.05 * mr + 5.0 * se, "{m} ± {se} vs {mr}");
+    assert!(
+        (m - mr).abs() <= 0.05 * mr + 5.0 * se,
+        "{integrator}: {m} ± {se} vs {mr}"
+    );
+}
+
+#[test]
+fn caustic_glass_photon_integrators_match_pbrt_v4_in_the_caustic() {
+    // SPPM and PPM: four seeds of 8 iterations × 200 000 photons; the photon
+    // map: four seeds of 16 passes (global 50 000, caustic 150 000 photons).
+    let sppm = "\"float radius\" [0.03] \"integer photonsperiteration\" [200000]";
+    assert_caustic("sppm", caustic_region("sppm", sppm, 4, 8));
+    assert_caustic("ppm", caustic_region("ppm", sppm, 4, 8));
+    let pm = "\"integer photons\" [50000] \"integer causticphotons\" [150000]";
+    assert_caustic("photonmap", caustic_region("photonmap", pm, 4, 16));
 }

@@ -17,10 +17,7 @@ pub type Built = (Vec<Primitive>, Vec<Light>, Vec<bool>);
 
 /// All primitives (instances flattened), the area lights they carry, and
 /// which `Texture` directives their `alpha` parameters used.
-pub fn primitives(
-    desc: &SceneDescription,
-    names: &MaterialNames,
-) -> Result<Built, BuildError> {
+pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Built, BuildError> {
     let mut prims = Vec::new();
     let mut lights = Vec::new();
     let mut tex = Textures::new(&desc.textures);
