@@ -166,11 +166,9 @@ fn bad_shape_parameters_are_errors_with_locations() {
 
 #[test]
 fn killeroo_geometry_builds_with_a_diffuse_material() {
-    let file = Path::new("/work/shared/scenes/killeroo-simple/geometry/killeroo.pbrt");
-    if !file.exists() {
-        eprintln!("skipped: {} not found", file.display());
-        return;
-    }
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/killeroo-simple/geometry/killeroo.pbrt");
+    assert!(file.exists(), "bundled scene missing: {}", file.display());
     let world = format!("Material \"diffuse\"\nInclude \"{}\"\n", file.display());
     let s = setup(&world).expect("builds");
     let text = format!("{HEADER}WorldBegin\n{world}");

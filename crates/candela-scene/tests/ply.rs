@@ -33,7 +33,7 @@ fn header_counts(path: &Path) -> (usize, usize) {
 
 #[test]
 fn caustic_glass_meshes() {
-    let dir = Path::new("/work/shared/scenes/caustic-glass/geometry");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/caustic-glass/geometry");
     for name in ["mesh_00001.ply", "mesh_00002.ply"] {
         let path = dir.join(name);
         let (nv, nf) = header_counts(&path);

@@ -30,7 +30,9 @@ impl Rng {
 }
 
 fn load(rel: &str) -> (PathBuf, Vec<u8>) {
-    let p = Path::new("/work/shared/scenes").join(rel);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(rel);
     let bytes = std::fs::read(&p).unwrap();
     (p, bytes)
 }

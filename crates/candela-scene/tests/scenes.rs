@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use candela_scene::*;
 
 fn scene(rel: &str) -> PathBuf {
-    Path::new("/work/shared/scenes").join(rel)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(rel)
 }
 
 #[test]
