@@ -166,6 +166,17 @@ impl SurfaceInteraction {
         };
     }
 
+    /// Adjoint correction for shading normals in importance transport,
+    /// |wo·ns||wi·ng| / (|wo·ng||wi·ns|) [Veach 1997, eq. 5.19]; 0 when degenerate.
+    pub fn importance_shading_correction(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (ns, ng) = (self.shading.n, self.it.n);
+        let den = wo.dot(ng).abs() * wi.dot(ns).abs();
+        if den == 0.0 {
+            return 0.0;
+        }
+        wo.dot(ns).abs() * wi.dot(ng).abs() / den
+    }
+
     /// The shading frame: z = shading normal, x along ∂p/∂u.
     pub fn shading_frame(&self) -> Frame {
         Frame::from_xz(self.shading.dpdu.normalize_or_zero(), self.shading.n)

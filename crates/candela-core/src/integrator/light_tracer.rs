@@ -21,7 +21,7 @@ use super::{Integrator, RenderContext};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::film::{RgbFilm, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
-use crate::math::{Vec2, Vec3};
+use crate::math::Vec2;
 use crate::sampling::{hash_u64s, Pcg32};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
@@ -145,7 +145,8 @@ impl LightTracer {
                 break;
             };
             beta *= bs.f
-                * (shading_correction(&si, si.wo, bs.wi) * bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0);
+                * (si.importance_shading_correction(si.wo, bs.wi) * bs.wi.dot(bsdf.ns()).abs()
+                    / bs.pdf.0);
             ray = si.spawn_ray(bs.wi);
             // Russian roulette on the carried power after a few bounces.
             let m = beta.max_component();
@@ -180,18 +181,7 @@ impl LightTracer {
         if f.is_black() || !ctx.scene.unoccluded(&si.it, &cs.p_lens) {
             return;
         }
-        let g = shading_correction(si, si.wo, cs.wi) * cs.wi.dot(bsdf.ns()).abs();
+        let g = si.importance_shading_correction(si.wo, cs.wi) * cs.wi.dot(bsdf.ns()).abs();
         buf.add(cs.p_raster, beta * f * (g * cs.we / cs.pdf.0), lambda);
     }
-}
-
-/// Adjoint correction for shading normals in importance transport
-/// [Veach 1997, eq. 5.19]: |wo·ns||wi·ng| / (|wo·ng||wi·ns|).
-fn shading_correction(si: &SurfaceInteraction, wo: Vec3, wi: Vec3) -> f32 {
-    let (ns, ng) = (si.shading.n, si.n());
-    let den = wo.dot(ng).abs() * wi.dot(ns).abs();
-    if den == 0.0 {
-        return 0.0;
-    }
-    wo.dot(ns).abs() * wi.dot(ng).abs() / den
 }

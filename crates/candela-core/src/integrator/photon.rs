@@ -24,7 +24,7 @@
 
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::interaction::SurfaceInteraction;
-use crate::math::{Vec2, Vec3};
+use crate::math::Vec2;
 use crate::sampling::{hash_u64s, Pcg32};
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -141,7 +141,7 @@ pub fn trace_photon(
         };
         let new_beta = beta
             * bs.f
-            * (shading_correction(&si, wo, bs.wi) * bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0);
+            * (si.importance_shading_correction(wo, bs.wi) * bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0);
         caustic &= bs.is_specular();
         if settings.caustic_only && !caustic {
             break;
@@ -156,14 +156,4 @@ pub fn trace_photon(
         ray = si.spawn_ray(bs.wi);
     }
     fate
-}
-
-/// Adjoint correction for shading normals [Veach 1997, eq. 5.19].
-fn shading_correction(si: &SurfaceInteraction, wo: Vec3, wi: Vec3) -> f32 {
-    let (ns, ng) = (si.shading.n, si.n());
-    let den = wo.dot(ng).abs() * wi.dot(ns).abs();
-    if den == 0.0 {
-        return 0.0;
-    }
-    wo.dot(ns).abs() * wi.dot(ng).abs() / den
 }

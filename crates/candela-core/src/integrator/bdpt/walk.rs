@@ -177,7 +177,11 @@ fn random_walk(
             break;
         };
         let cos = bs.wi.dot(bsdf.ns()).abs();
-        beta *= bs.f * (cos * shading_correction(&si, wo, bs.wi, mode) / bs.pdf.0);
+        let correction = match mode {
+            TransportMode::Radiance => 1.0,
+            TransportMode::Importance => si.importance_shading_correction(wo, bs.wi),
+        };
+        beta *= bs.f * (cos * correction / bs.pdf.0);
         pdf_dir = if bs.pdf_is_proportional {
             bsdf.pdf(wo, bs.wi, mode, SampleFlags::ALL).0
         } else {
@@ -219,25 +223,6 @@ fn push_escape(
     v.mode = TransportMode::Radiance;
     v.pdf_fwd = pdf_dir;
     path.push(v);
-}
-
-/// Adjoint correction for shading normals in importance transport
-/// [Veach 1997, eq. 5.19]; 1 in radiance mode.
-pub(crate) fn shading_correction(
-    si: &crate::interaction::SurfaceInteraction,
-    wo: Vec3,
-    wi: Vec3,
-    mode: TransportMode,
-) -> f32 {
-    if mode == TransportMode::Radiance {
-        return 1.0;
-    }
-    let (ns, ng) = (si.shading.n, si.n());
-    let den = wo.dot(ng).abs() * wi.dot(ns).abs();
-    if den == 0.0 {
-        return 0.0;
-    }
-    wo.dot(ns).abs() * wi.dot(ng).abs() / den
 }
 
 /// Russian roulette after the third vertex on the throughput (η²-corrected
