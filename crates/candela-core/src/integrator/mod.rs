@@ -7,6 +7,7 @@
 //! pass, each pass with its own photon maps, and has its own loop.
 
 mod bdpt;
+mod direct;
 pub mod driver;
 mod light_tracer;
 mod path;

@@ -5,8 +5,8 @@
 use super::maps::{Lookup, PassMaps, Query};
 use super::PhotonMapSettings;
 use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
+use crate::integrator::direct::light_sampled_direct;
 use crate::interaction::SurfaceInteraction;
-use crate::light::LightSampleContext;
 use crate::math::{Ray, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -95,7 +95,7 @@ impl CameraWalk<'_> {
         sampler: &mut Sampler,
         scratch: &mut Vec<Neighbor>,
     ) -> SampledSpectrum {
-        let direct = self.direct(v, lambda, sampler);
+        let direct = light_sampled_direct(self.scene, v.si, v.bsdf, v.wo, lambda, sampler);
         let caustic = self
             .maps
             .caustic
@@ -119,34 +119,6 @@ impl CameraWalk<'_> {
             // j + d − 1 ≤ maxdepth for a photon at its d-th hit read at vertex j.
             max_photon_depth: self.settings.max_depth + 1 - v.depth,
         }
-    }
-
-    /// Next-event estimation by light sampling alone (nothing else samples
-    /// the direct paths of a non-specular vertex, so no MIS weight).
-    fn direct(
-        &self,
-        v: &Vertex<'_>,
-        lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-    ) -> SampledSpectrum {
-        let scene = self.scene;
-        let ctx = LightSampleContext::from_surface(v.si);
-        let u_light = sampler.get_1d();
-        let u = sampler.get_2d();
-        let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
-            return SampledSpectrum::zero();
-        };
-        let Some(ls) = scene.light(id).sample_li(&ctx, u, lambda) else {
-            return SampledSpectrum::zero();
-        };
-        if ls.l.is_black() || ls.pdf.0 == 0.0 {
-            return SampledSpectrum::zero();
-        }
-        let f = v.bsdf.f(v.wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(v.bsdf.ns()).abs();
-        if f.is_black() || !scene.unoccluded(&v.si.it, &ls.p_light) {
-            return SampledSpectrum::zero();
-        }
-        f * ls.l / (pmf * ls.pdf.0)
     }
 
     /// Indirect light at `v` by `gatherrays` BSDF samples of its non-specular

@@ -27,10 +27,10 @@
 
 use crate::bsdf::{Bsdf, BxdfFlags, SampleFlags, TransportMode};
 use crate::film::RgbFilm;
+use crate::integrator::direct::light_sampled_direct;
 use crate::integrator::driver::camera_sample;
 use crate::integrator::photon::{trace_photon, ShootSettings};
 use crate::integrator::RenderContext;
-use crate::light::LightSampleContext;
 use crate::math::{UVec2, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -138,7 +138,7 @@ fn visit_pixel(
         };
         let flags = bsdf.flags();
         if flags.is_non_specular() {
-            ld += beta * direct_light(scene, &si, &bsdf, &lam, sampler);
+            ld += beta * light_sampled_direct(scene, &si, &bsdf, si.wo, &lam, sampler);
         }
         let glossy_last = flags.contains(BxdfFlags::GLOSSY) && depth + 1 == max_depth;
         if flags.contains(BxdfFlags::DIFFUSE) || glossy_last {
@@ -168,34 +168,6 @@ fn visit_pixel(
     }
     visit.ld = film.sensor().to_sensor_rgb(ld, &lam);
     visit
-}
-
-/// One light sample at a non-specular vertex (no MIS: emission is only
-/// counted after specular bounces, so light sampling is the sole strategy).
-fn direct_light(
-    scene: &Scene,
-    si: &crate::interaction::SurfaceInteraction,
-    bsdf: &Bsdf,
-    lambda: &SampledWavelengths,
-    sampler: &mut Sampler,
-) -> SampledSpectrum {
-    let (u_light, u) = (sampler.get_1d(), sampler.get_2d());
-    let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
-        return SampledSpectrum::zero();
-    };
-    let light = scene.light(id);
-    let ctx = LightSampleContext::from_surface(si);
-    let Some(ls) = light.sample_li(&ctx, u, lambda) else {
-        return SampledSpectrum::zero();
-    };
-    if ls.l.is_black() || ls.pdf.0 == 0.0 {
-        return SampledSpectrum::zero();
-    }
-    let f = bsdf.f(si.wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(bsdf.ns()).abs();
-    if f.is_black() || !scene.unoccluded(&si.it, &ls.p_light) {
-        return SampledSpectrum::zero();
-    }
-    f * ls.l / (pmf * ls.pdf.0)
 }
 
 /// A visible point's sphere for the grid (negative radius: none).
