@@ -16,9 +16,11 @@
 //! (a − b)²/4, so σ² of the region mean is Σ(a − b)²/(4n²): noise only,
 //! without the image's own spatial variation.
 
+mod common;
+
 use candela_core::image::RgbImage;
-use candela_core::integrator::{NoProgress, RenderContext};
-use candela_core::scene::build::{build, Overrides};
+use candela_core::scene::build::Overrides;
+use common::render_at;
 use std::path::{Path, PathBuf};
 
 fn scene_dir(name: &str) -> PathBuf {
@@ -28,23 +30,14 @@ fn scene_dir(name: &str) -> PathBuf {
 }
 
 fn render(file: &Path, integrator: &str, spp: u32, seed: u64) -> RgbImage {
-    let desc = candela_scene::parse_file(file).expect("scene parses");
+    let text = std::fs::read_to_string(file).expect("scene file");
     let ov = Overrides {
         spp: Some(spp),
         seed: Some(seed),
         integrator: Some(integrator.into()),
         ..Default::default()
     };
-    let mut setup = build(&desc, &ov).expect("scene builds");
-    let ctx = RenderContext {
-        scene: &setup.scene,
-        camera: &setup.camera,
-        sampler: &setup.sampler,
-        progress: &NoProgress,
-    };
-    setup.integrator.render(&ctx, &mut setup.film);
-    assert_eq!(setup.film.dropped_samples(), 0, "non-finite samples");
-    setup.film.image()
+    render_at(&text, file, &ov).0
 }
 
 /// Two renders with independent seeds.
@@ -147,7 +140,6 @@ fn caustic_region(integrator: &str, params: &str, seeds: u64, spp: u32) -> (f64,
             "Film \"rgb\" \"float cropwindow\" [0.342857 0.742857 0.4 0.66]",
         );
     assert!(text.contains(integrator) && text.contains("cropwindow"));
-    let desc = candela_scene::parse_str(&text, &dir.join("scene.pbrt")).expect("parses");
     let means: Vec<f64> = (0..seeds)
         .map(|seed| {
             let ov = Overrides {
@@ -155,16 +147,7 @@ fn caustic_region(integrator: &str, params: &str, seeds: u64, spp: u32) -> (f64,
                 seed: Some(seed),
                 ..Default::default()
             };
-            let mut setup = build(&desc, &ov).expect("builds");
-            let ctx = RenderContext {
-                scene: &setup.scene,
-                camera: &setup.camera,
-                sampler: &setup.sampler,
-                progress: &NoProgress,
-            };
-            setup.integrator.render(&ctx, &mut setup.film);
-            assert_eq!(setup.film.dropped_samples(), 0);
-            let img = setup.film.image();
+            let img = render_at(&text, &dir.join("scene.pbrt"), &ov).0;
             assert_eq!((img.width, img.height), (140, 130), "crop window");
             let full = [0, 0, img.width, img.height];
             pixels(full).map(|(x, y)| luma(&img, x, y)).sum::<f64>() / (140.0 * 130.0)
