@@ -154,3 +154,24 @@ fn ppm_partial_renders_merge_into_the_full_render_bit_for_bit() {
     first.write_film(&mut film_merged);
     assert_eq!(film_full.image(), film_merged.image());
 }
+
+/// The gather radius is checked against the scene's scale: in the unit-sphere
+/// furnace (diagonal 2√3 ≈ 3.46) pbrt-v4's default radius 1 is 29 % of it and
+/// warned about, 0.02 (0.6 %) is not, 1e-6 is warned about as tiny.
+#[test]
+fn photon_radius_far_from_the_scene_scale_is_warned_about() {
+    let warned = |integrator: &str, radius: f32| {
+        let desc = candela_scene::parse_str(&furnace(integrator, radius), Path::new("f.pbrt"))
+            .expect("scene parses");
+        let setup = build(&desc, &Overrides::default()).expect("scene builds");
+        setup
+            .warnings
+            .iter()
+            .any(|w| w.contains("\"radius\"") && w.contains("f.pbrt:6:"))
+    };
+    for integrator in ["sppm", "ppm"] {
+        assert!(warned(integrator, 1.0), "{integrator}: radius 1");
+        assert!(!warned(integrator, 0.02), "{integrator}: radius 0.02");
+        assert!(warned(integrator, 1e-6), "{integrator}: radius 1e-6");
+    }
+}
