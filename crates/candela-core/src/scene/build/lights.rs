@@ -96,7 +96,7 @@ fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError>
             illum("I")?,
             scale,
             p.get_float("coneangle", 30.0)?,
-            p.get_float("conedelta", 5.0)?,
+            p.get_float("conedeltaangle", 5.0)?,
             optional_positive(p.get_float("power", -1.0)?),
             v3("from", Vec3::ZERO)?,
             v3("to", Vec3::Z)?,
