@@ -22,6 +22,9 @@ pub struct Interaction {
     pub n: Vec3,
     /// Surface parameterisation.
     pub uv: Vec2,
+    /// Time of the path this point belongs to (motion blur); rays spawned
+    /// here carry it.
+    pub time: f32,
 }
 
 impl Interaction {
@@ -32,6 +35,7 @@ impl Interaction {
             p_error: Vec3::ZERO,
             n: Vec3::ZERO,
             uv: Vec2::ZERO,
+            time: 0.0,
         }
     }
     /// True for points on surfaces.
@@ -40,17 +44,17 @@ impl Interaction {
     }
     /// Ray leaving this point in direction `d`.
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        spawn_ray(self.p, self.p_error, self.n, d)
+        spawn_ray(self.p, self.p_error, self.n, d).at_time(self.time)
     }
     /// Shadow ray from this point towards another interaction; `t ∈ (0, 1 − ε)` spans the gap.
     pub fn spawn_ray_to(&self, to: &Interaction) -> Ray {
         let pf = offset_ray_origin(self.p, self.p_error, self.n, to.p - self.p);
         let pt = offset_ray_origin(to.p, to.p_error, to.n, pf - to.p);
-        Ray::new(pf, pt - pf)
+        Ray::new(pf, pt - pf).at_time(self.time)
     }
     /// Shadow ray towards a bare point.
     pub fn spawn_ray_to_point(&self, p: Vec3) -> Ray {
-        spawn_ray_to(self.p, self.p_error, self.n, p)
+        spawn_ray_to(self.p, self.p_error, self.n, p).at_time(self.time)
     }
 }
 
@@ -109,7 +113,13 @@ impl SurfaceInteraction {
             n = -n;
         }
         Self {
-            it: Interaction { p, p_error, n, uv },
+            it: Interaction {
+                p,
+                p_error,
+                n,
+                uv,
+                time: 0.0,
+            },
             wo,
             dpdu,
             dpdv,

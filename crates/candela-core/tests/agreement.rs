@@ -120,3 +120,38 @@ fn photon_integrators_agree_with_the_path_tracer_on_the_cornell_box() {
     assert_agree(&pt, &sppm, "Cornell PT vs SPPM");
     assert_agree(&pt, &ppm, "Cornell PT vs PPM");
 }
+
+/// A black square sliding under a point light casts a moving shadow on a
+/// white floor: light subpaths must see the square at their path's time, so
+/// the light tracer's and BDPT's shadows blur exactly like the path tracer's
+/// (a light tracer whose paths all ran at time 0 leaves a sharp shadow at the
+/// start position and fails here).
+#[test]
+fn path_light_and_bidirectional_tracers_agree_on_a_moving_shadow() {
+    let scene = r#"LookAt 0 -4 6  0 0 0  0 0 1
+Camera "perspective" "float fov" [45]
+Film "rgb" "integer xresolution" [32] "integer yresolution" [32]
+PixelFilter "box"
+Sampler "independent"
+Integrator "path" "integer maxdepth" [3]
+WorldBegin
+LightSource "point" "point3 from" [0 0 4] "rgb I" [20 20 20]
+Material "diffuse" "rgb reflectance" [0.8 0.8 0.8]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point3 P" [-3 -3 0  3 -3 0  3 3 0  -3 3 0]
+AttributeBegin
+  Material "diffuse" "rgb reflectance" [0 0 0]
+  Translate -1 0 2
+  ActiveTransform EndTime
+  Translate 2 0 0
+  ActiveTransform All
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+      "point3 P" [-0.5 -0.5 0  0.5 -0.5 0  0.5 0.5 0  -0.5 0.5 0]
+AttributeEnd
+"#;
+    let pt = block_means(scene, "path", 16);
+    let lt = block_means(scene, "lightpath", 16);
+    let bd = block_means(scene, "bdpt", 8);
+    assert_agree(&pt, &lt, "moving shadow PT vs LT");
+    assert_agree(&pt, &bd, "moving shadow PT vs BDPT");
+}

@@ -188,16 +188,23 @@ impl Builder {
         self.gs.reverse_orientation = !self.gs.reverse_orientation;
     }
 
-    /// The start-time CTM, warning once if the end-time CTM differs.
-    pub(crate) fn ctm(&mut self, loc: &Loc) -> Mat4d {
+    /// The start-time CTM for a directive that cannot move (`what`: camera,
+    /// light, texture), warning once if the end-time CTM differs.
+    pub(crate) fn ctm(&mut self, loc: &Loc, what: &str) -> Mat4d {
         if self.gs.ctm[0] != self.gs.ctm[1] && !self.warned_motion {
             self.warned_motion = true;
             self.warn(
                 loc,
-                "motion blur is not supported; using the start transform",
+                format!("motion of a {what} is not supported (only shapes and object instances move); using its start transform"),
             );
         }
         self.gs.ctm[0]
+    }
+
+    /// The start-time CTM, and the end-time CTM when it differs.
+    pub(crate) fn ctm_motion(&self) -> (Mat4d, Option<Mat4d>) {
+        let [start, end] = self.gs.ctm;
+        (start, (start != end).then_some(end))
     }
 
     // ---- options block ------------------------------------------------
@@ -224,7 +231,7 @@ impl Builder {
     /// `Camera "name" params`.
     pub(crate) fn camera(&mut self, name: String, params: ParamSet, loc: &Loc) -> Result<()> {
         self.require_options("Camera", loc)?;
-        let camera_from_world = self.ctm(loc);
+        let camera_from_world = self.ctm(loc, "camera");
         let world_from_camera = self.gs.ctm.map(|m| m.inverse());
         match world_from_camera {
             [Some(a), Some(b)] => {

@@ -121,6 +121,9 @@ pub struct ShapeDesc {
     /// The CTM at the directive (relative to the instance inside
     /// `ObjectBegin`/`ObjectEnd`).
     pub render_from_object: Mat4d,
+    /// The CTM at `TransformTimes`' end time when it differs from the start
+    /// (`ActiveTransform EndTime`): the shape moves during the shutter.
+    pub render_from_object_end: Option<Mat4d>,
     /// Whether `ReverseOrientation` was in effect.
     pub reverse_orientation: bool,
     /// The current material.
@@ -151,6 +154,8 @@ pub struct InstanceUse {
     pub name: String,
     /// The CTM at the directive.
     pub render_from_instance: Mat4d,
+    /// The CTM at the end time when it differs (a moving instance).
+    pub render_from_instance_end: Option<Mat4d>,
     /// Where the directive is.
     pub loc: Loc,
 }

@@ -54,7 +54,7 @@ impl Builder {
             return Err(SceneError::at(loc, format!("redefining texture '{name}'")));
         }
         let params = with_defaults(&self.gs.attributes.texture, params);
-        let render_from_texture = self.ctm(loc);
+        let render_from_texture = self.ctm(loc, "texture");
         self.desc.textures.push(TextureDesc {
             name,
             kind,
@@ -134,7 +134,7 @@ impl Builder {
             self.warn(loc, w);
         }
         let params = with_defaults(&self.gs.attributes.light, params);
-        let render_from_light = self.ctm(loc);
+        let render_from_light = self.ctm(loc, "light");
         self.desc.lights.push(LightDesc {
             name,
             params,
@@ -171,7 +171,7 @@ impl Builder {
             self.warn(loc, w);
         }
         let params = with_defaults(&self.gs.attributes.shape, params);
-        let render_from_object = self.ctm(loc);
+        let (render_from_object, render_from_object_end) = self.ctm_motion();
         let mut area_light = self.gs.area_light.clone();
         if self.object.is_some() && area_light.is_some() {
             self.warn(
@@ -184,6 +184,7 @@ impl Builder {
             name,
             params,
             render_from_object,
+            render_from_object_end,
             reverse_orientation: self.gs.reverse_orientation,
             material: self.gs.material.clone(),
             area_light,
@@ -240,10 +241,11 @@ impl Builder {
                 "ObjectInstance can't be used inside an instance definition",
             ));
         }
-        let render_from_instance = self.ctm(loc);
+        let (render_from_instance, render_from_instance_end) = self.ctm_motion();
         self.desc.instances.push(InstanceUse {
             name,
             render_from_instance,
+            render_from_instance_end,
             loc: loc.clone(),
         });
         Ok(())

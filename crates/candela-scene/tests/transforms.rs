@@ -215,17 +215,26 @@ fn named_materials_textures_color_space_and_options() {
 }
 
 #[test]
-fn motion_blur_and_world_end_warn() {
+fn moving_shapes_keep_both_transforms_and_world_end_warns() {
     let d = parse(
         "WorldBegin ActiveTransform EndTime Translate 1 0 0 ActiveTransform All
          Shape \"sphere\" WorldEnd",
     );
     assert_mat(&d.shapes[0].render_from_object, &Mat4d::IDENTITY);
-    assert_eq!(d.warnings.len(), 2, "{:?}", d.warnings);
-    assert!(d.warnings[0]
-        .message
-        .contains("motion blur is not supported"));
-    assert!(d.warnings[1].message.contains("WorldEnd"));
+    let end = d.shapes[0].render_from_object_end.expect("the shape moves");
+    assert_eq!(end.m[0][3], 1.0, "{end:?}");
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    assert!(d.warnings[0].message.contains("WorldEnd"));
+}
+
+#[test]
+fn moving_lights_warn_and_keep_their_start_transform() {
+    let d = parse(
+        "WorldBegin ActiveTransform EndTime Translate 1 0 0 ActiveTransform All
+         LightSource \"point\"",
+    );
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    assert!(d.warnings[0].message.contains("motion of a light"));
 }
 
 #[test]

@@ -239,6 +239,7 @@ impl CameraFrame {
             p_error,
             n: self.forward,
             uv: Vec2::ZERO,
+            time: 0.0,
         }
     }
 }

@@ -136,10 +136,11 @@ pub(crate) fn camera_sample(
     let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
     let fs = film.filter().sample(sampler.get_pixel_2d());
     let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
+    let time = ctx.scene.sample_time(|| sampler.get_1d());
     let p_lens = sampler.get_2d();
     let cr = ctx.camera.generate_ray(CameraSample { p_film, p_lens })?;
     Some(PixelSample {
-        ray: cr.ray,
+        ray: cr.ray.at_time(time),
         ray_weight: cr.weight,
         lambda,
         filter_weight: fs.weight,

@@ -99,6 +99,7 @@ impl LightTracer {
         let Some(les) = light.sample_le(rng.u2(), rng.u2(), &lambda) else {
             return;
         };
+        let les = les.at_time(scene.sample_time(|| rng.u1()));
         if les.pdf_pos.0 == 0.0 || les.pdf_dir.0 == 0.0 || les.l.is_black() {
             return;
         }

@@ -96,6 +96,7 @@ pub fn trace_photon(
     let Some(les) = scene.light(id).sample_le(rng.u2(), rng.u2(), lambda) else {
         return fate;
     };
+    let les = les.at_time(scene.sample_time(|| rng.u1()));
     let mut beta = les.beta0(p_light);
     let mut ray = les.ray;
     let mut lam = *lambda;

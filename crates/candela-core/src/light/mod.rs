@@ -158,6 +158,14 @@ pub struct LightLeSample {
 }
 
 impl LightLeSample {
+    /// The same emission at path time `time` (motion blur).
+    pub fn at_time(mut self, time: f32) -> Self {
+        self.ray.time = time;
+        if let Some(it) = &mut self.intr {
+            it.time = time;
+        }
+        self
+    }
     /// |cos θ| between the surface normal and the ray (1 without a surface).
     #[inline]
     pub fn abs_cos_theta(&self) -> f32 {

@@ -1,11 +1,13 @@
 //! Geometry and floating-point support: vectors (glam), frames, bounds, rays
 //! with error-bounded origins, transforms, and small numeric helpers.
 
+mod animated;
 mod bounds;
 mod frame;
 mod ray;
 mod transform;
 
+pub use animated::AnimatedTransform;
 pub use bounds::Bounds3;
 pub use frame::Frame;
 pub use glam::{Mat3, Mat4, UVec2, Vec2, Vec3, Vec4};

@@ -20,13 +20,21 @@ pub struct Ray {
     pub o: Vec3,
     /// Direction (not necessarily normalised).
     pub d: Vec3,
+    /// Time within the shutter interval; moving geometry is placed at this
+    /// time (0 and irrelevant in static scenes).
+    pub time: f32,
 }
 
 impl Ray {
-    /// New ray.
+    /// New ray at time 0.
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        Self { o, d }
+        Self { o, d, time: 0.0 }
+    }
+    /// The same ray at another time.
+    #[inline]
+    pub fn at_time(self, time: f32) -> Self {
+        Self { time, ..self }
     }
     /// Point at parameter `t`.
     #[inline]

@@ -119,14 +119,20 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         ));
     }
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
-    let (primitives, mut lights, alpha_used) = geometry::primitives(desc, &names)?;
+    let geometry::Built {
+        prims,
+        movers,
+        mut lights,
+        textures_used: alpha_used,
+    } = geometry::primitives(desc, &names)?;
     let textures_used: Vec<bool> = textures_used
         .iter()
         .zip(&alpha_used)
         .map(|(a, b)| *a || *b)
         .collect();
     lights.extend(lights::lights(desc, &mut warnings)?);
-    let scene = Scene::new(primitives, materials, lights, power_sampling);
+    let shutter = entities::shutter(desc)?;
+    let scene = Scene::with_motion(prims, movers, shutter, materials, lights, power_sampling);
     if let Some(w) = photon_radius_warning(desc, &integrator_name, &scene)? {
         warnings.push(w);
     }

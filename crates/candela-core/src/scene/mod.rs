@@ -2,8 +2,10 @@
 //! light sampler. Built from a plain description by [`build`].
 
 pub mod build;
+mod motion;
 mod primitive;
 
+pub use motion::MovingGroup;
 pub use primitive::Primitive;
 
 use crate::accel::Bvh;
@@ -20,6 +22,10 @@ use rayon::prelude::*;
 /// Everything rays can hit or be lit by.
 pub struct Scene {
     primitives: Vec<Primitive>,
+    /// Moving geometry; BVH item `primitives.len() + k` is `movers[k]`.
+    movers: Vec<MovingGroup>,
+    /// The shutter interval when anything moves.
+    shutter: Option<(f32, f32)>,
     bvh: Bvh,
     materials: Vec<Material>,
     lights: Vec<Light>,
@@ -33,10 +39,32 @@ impl Scene {
     pub fn new(
         primitives: Vec<Primitive>,
         materials: Vec<Material>,
+        lights: Vec<Light>,
+        power_sampling: bool,
+    ) -> Self {
+        Self::with_motion(
+            primitives,
+            Vec::new(),
+            (0.0, 1.0),
+            materials,
+            lights,
+            power_sampling,
+        )
+    }
+
+    /// Assembles a scene with moving geometry, seen over the camera's
+    /// `shutter` interval (open, close).
+    pub fn with_motion(
+        primitives: Vec<Primitive>,
+        movers: Vec<MovingGroup>,
+        shutter: (f32, f32),
+        materials: Vec<Material>,
         mut lights: Vec<Light>,
         power_sampling: bool,
     ) -> Self {
-        let prim_bounds: Vec<Bounds3> = primitives.par_iter().map(|p| p.shape.bounds()).collect();
+        let mut prim_bounds: Vec<Bounds3> =
+            primitives.par_iter().map(|p| p.shape.bounds()).collect();
+        prim_bounds.extend(movers.iter().map(|m| m.bounds()));
         let bounds = prim_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
         let bvh = Bvh::build(&prim_bounds);
         for l in &mut lights {
@@ -53,6 +81,8 @@ impl Scene {
         };
         Self {
             primitives,
+            shutter: (!movers.is_empty()).then_some(shutter),
+            movers,
             bvh,
             materials,
             lights,
@@ -66,13 +96,29 @@ impl Scene {
     pub fn bounds(&self) -> Bounds3 {
         self.bounds
     }
-    /// Number of primitives.
+    /// Number of primitives (static and moving).
     pub fn primitive_count(&self) -> usize {
-        self.primitives.len()
+        self.primitives.len() + self.movers.iter().map(|m| m.len()).sum::<usize>()
     }
-    /// All primitives.
+    /// The shutter interval, when anything in the scene moves.
+    pub fn shutter(&self) -> Option<(f32, f32)> {
+        self.shutter
+    }
+    /// A time for a path: uniform over the shutter when something moves
+    /// (consuming `u`), else 0 (static scenes are the same at every time).
+    pub fn sample_time(&self, u: impl FnOnce() -> f32) -> f32 {
+        match self.shutter {
+            Some((open, close)) => open + (close - open) * u(),
+            None => 0.0,
+        }
+    }
+    /// All static primitives.
     pub fn primitives(&self) -> &[Primitive] {
         &self.primitives
+    }
+    /// The moving shapes.
+    pub fn moving_groups(&self) -> &[MovingGroup] {
+        &self.movers
     }
     /// All lights.
     pub fn lights(&self) -> &[Light] {
@@ -98,30 +144,55 @@ impl Scene {
 
     /// Closest hit along `ray` before `t_max`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
-        let mut best = None;
+        if self.movers.is_empty() {
+            let (i, hit) = motion::closest_hit(&self.primitives, &self.bvh, ray, t_max)?;
+            return Some(self.finish(i, hit, ray));
+        }
+        let n = self.primitives.len() as u32;
         let wr = WatertightRay::new(ray);
+        let mut best = None;
         self.bvh.intersect(ray, t_max, |i, ray, t_max| {
+            if i >= n {
+                let (t, si) = self.movers[(i - n) as usize].intersect(ray, t_max)?;
+                best = Some(Err(si));
+                return Some(t);
+            }
             let prim = &self.primitives[i as usize];
             let hit = prim.shape.intersect_deferred(ray, &wr, t_max)?;
             if prim.alpha.is_some() && !prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray) {
                 return None;
             }
             let t = hit.t();
-            best = Some((i, hit));
+            best = Some(Ok((i, hit)));
             Some(t)
         });
-        let (i, hit) = best?;
+        match best? {
+            Ok((i, hit)) => Some(self.finish(i, hit, ray)),
+            Err(si) => Some(si),
+        }
+    }
+
+    /// The interaction of a static primitive's deferred hit.
+    fn finish(&self, i: u32, hit: crate::shape::DeferredHit, ray: &Ray) -> SurfaceInteraction {
         let prim = &self.primitives[i as usize];
         let mut si = prim.shape.finish_hit(hit, ray).si;
         si.material = prim.material;
         si.area_light = prim.area_light;
-        Some(si)
+        si.it.time = ray.time;
+        si
     }
 
     /// True if anything blocks `ray` before `t_max`.
     pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.movers.is_empty() {
+            return motion::any_hit(&self.primitives, &self.bvh, ray, t_max);
+        }
+        let n = self.primitives.len() as u32;
         let wr = WatertightRay::new(ray);
         self.bvh.intersect_p(ray, t_max, |i, ray, t_max| {
+            if i >= n {
+                return self.movers[(i - n) as usize].intersect_p(ray, t_max);
+            }
             let prim = &self.primitives[i as usize];
             if prim.alpha.is_none() {
                 return prim.shape.intersect_p(ray, t_max);

@@ -265,6 +265,7 @@ impl BilinearPatch {
             p_error: Self::point_error(&p),
             n,
             uv: st,
+            time: 0.0,
         };
         Some(ShapeSample { intr, pdf })
     }

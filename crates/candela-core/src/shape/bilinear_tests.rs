@@ -279,6 +279,7 @@ fn area_density_integrates_to_one() {
                 p_error: Vec3::ZERO,
                 n: Vec3::Z,
                 uv: Vec2::new(u as f32, v as f32),
+                time: 0.0,
             };
             let dpdu = q[1].lerp(q[3], v) - q[0].lerp(q[2], v);
             let dpdv = q[2].lerp(q[3], u) - q[0].lerp(q[1], u);

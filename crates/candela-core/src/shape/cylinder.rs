@@ -272,6 +272,7 @@ impl Cylinder {
             p_error,
             n: self.normal_at(p_obj),
             uv: self.uv(p_obj, phi),
+            time: 0.0,
         };
         Some(ShapeSample { intr, pdf })
     }

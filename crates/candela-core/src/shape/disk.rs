@@ -166,6 +166,7 @@ impl Disk {
             p_error,
             n: self.normal(),
             uv: self.uv(pd.length(), phi_of(p_obj)),
+            time: 0.0,
         };
         Some(ShapeSample {
             intr,

@@ -231,6 +231,7 @@ impl Sphere {
             p_error,
             n: self.normal_at(p_obj),
             uv: self.uv(p_obj, phi_of(p_obj)),
+            time: 0.0,
         }
     }
 
@@ -297,6 +298,7 @@ impl Sphere {
                 n_out
             },
             uv: self.uv(p_obj, phi_of(p_obj)),
+            time: 0.0,
         };
         let pdf = PdfSolidAngle(1.0 / (2.0 * PI * one_minus_cos_max));
         pdf.0.is_finite().then_some(ShapeSampleSa { intr, pdf })

@@ -347,6 +347,7 @@ impl Triangle {
             p_error: gamma(6) * abs_sum,
             n: self.oriented_normal(b),
             uv: b[0] * uv[0] + b[1] * uv[1] + b[2] * uv[2],
+            time: 0.0,
         };
         Some(ShapeSample {
             intr,

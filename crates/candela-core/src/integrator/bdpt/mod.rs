@@ -126,7 +126,15 @@ impl BdptIntegrator {
             walk(max_depth + 1),
             &mut cam,
         );
-        generate_light_subpath(ctx.scene, lambda, sampler, walk(max_depth), &mut light);
+        let time = ray.time;
+        generate_light_subpath(
+            ctx.scene,
+            time,
+            lambda,
+            sampler,
+            walk(max_depth),
+            &mut light,
+        );
         let lambda = *lambda;
         let cx = ConnectCtx {
             scene: ctx.scene,

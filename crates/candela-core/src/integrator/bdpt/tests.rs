@@ -260,6 +260,7 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
         );
         generate_light_subpath(
             &rs.scene,
+            cr.ray.time,
             &mut lambda,
             &mut sampler,
             walk(max_depth),
@@ -327,4 +328,58 @@ fn mis_weights_sum_to_one_under_infinite_and_distant_lights() {
             "{cov:?}"
         );
     }
+}
+
+/// Both subpaths of one path live at the camera ray's time: every vertex of
+/// the light subpath (light point included) and of the camera subpath carries
+/// it, so connections test visibility against moving geometry at one instant.
+#[test]
+fn both_subpaths_carry_the_camera_rays_time() {
+    let moving = format!(
+        "{BOX}AttributeBegin\n  ActiveTransform EndTime\n  Translate 0 0.5 0\n  ActiveTransform All\n  Shape \"sphere\" \"float radius\" [0.2]\nAttributeEnd\n"
+    );
+    let rs = setup(&moving);
+    assert!(rs.scene.shutter().is_some(), "the sphere must move");
+    let walk = |max_vertices| WalkSettings {
+        max_vertices,
+        regularize: false,
+    };
+    let mut sampler = Sampler::new(SamplerKind::Independent, 1, 3);
+    let (mut cam, mut light) = (Vec::new(), Vec::new());
+    let mut vertices = 0;
+    for i in 0..200u32 {
+        sampler.start_pixel_sample(UVec2::new(i % 32, i / 32), i, 0);
+        let mut lambda = SampledWavelengths::sample_visible(sampler.get_1d());
+        let time = sampler.get_1d();
+        let sample = CameraSample {
+            p_film: Vec2::new(32.0 * sampler.get_1d(), 32.0 * sampler.get_1d()),
+            p_lens: sampler.get_2d(),
+        };
+        let Some(cr) = rs.camera.generate_ray(sample) else {
+            continue;
+        };
+        let ray = cr.ray.at_time(time);
+        generate_camera_subpath(
+            &rs.scene,
+            &rs.camera,
+            ray,
+            &mut lambda,
+            &mut sampler,
+            walk(6),
+            &mut cam,
+        );
+        generate_light_subpath(
+            &rs.scene,
+            time,
+            &mut lambda,
+            &mut sampler,
+            walk(5),
+            &mut light,
+        );
+        for v in cam.iter().chain(&light) {
+            assert_eq!(v.it.time, time, "vertex {:?}", v.kind);
+            vertices += 1;
+        }
+    }
+    assert!(vertices > 1000, "{vertices}");
 }

@@ -41,7 +41,11 @@ pub(crate) fn generate_camera_subpath(
     path: &mut Vec<Vertex>,
 ) {
     path.clear();
-    let mut cam = Vertex::camera(Interaction::at_point(ray.o), SampledSpectrum::one());
+    let lens = Interaction {
+        time: ray.time,
+        ..Interaction::at_point(ray.o)
+    };
+    let mut cam = Vertex::camera(lens, SampledSpectrum::one());
     let (pdf_pos, pdf_dir) = camera.pdf_we(&ray);
     cam.pdf_fwd = pdf_pos.0;
     path.push(cam);
@@ -62,9 +66,11 @@ pub(crate) fn generate_camera_subpath(
 /// A light subpath: a light chosen by the scene's light sampler, its
 /// emitted ray, then up to `max_vertices` surface vertices. The first
 /// vertex's β is Le·|cos θ|/(p_light·p_pos·p_dir), the subpath's share of the
-/// emitted power (seed §3.2).
+/// emitted power (seed §3.2). `time` is the camera subpath's: both halves
+/// of a path see moving geometry at one instant.
 pub(crate) fn generate_light_subpath(
     scene: &Scene,
+    time: f32,
     lambda: &mut SampledWavelengths,
     sampler: &mut Sampler,
     settings: WalkSettings,
@@ -80,6 +86,7 @@ pub(crate) fn generate_light_subpath(
     let Some(les) = light.sample_le(u1, u2, lambda) else {
         return;
     };
+    let les = les.at_time(time);
     if les.pdf_pos.0 == 0.0 || les.pdf_dir.0 == 0.0 || les.l.is_black() {
         return;
     }
@@ -87,7 +94,10 @@ pub(crate) fn generate_light_subpath(
         light.light_type(),
         LightType::Infinite | LightType::DeltaDirection
     );
-    let it = les.intr.unwrap_or(Interaction::at_point(les.ray.o));
+    let it = les.intr.unwrap_or(Interaction {
+        time,
+        ..Interaction::at_point(les.ray.o)
+    });
     let w_inf = if at_infinity { les.ray.d } else { Vec3::ZERO };
     let mut v0 = Vertex::light(
         id,

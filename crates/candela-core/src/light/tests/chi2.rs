@@ -244,6 +244,7 @@ fn chi2_area_light_le() {
             p_error: Vec3::ZERO,
             n: -Vec3::Z,
             uv: Vec2::ZERO,
+            time: 0.0,
         };
         let lam = lambda();
         let sample = |r: &mut Pcg32| light.sample_le(u2(r), u2(r), &lam).map(|s| s.ray.d);

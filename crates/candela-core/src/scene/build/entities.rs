@@ -84,8 +84,15 @@ pub fn film(desc: &SceneDescription, ov: &Overrides) -> Result<(RgbFilm, PathBuf
 }
 
 fn camera_exposure(desc: &SceneDescription) -> Result<f32, BuildError> {
+    let (open, close) = shutter(desc)?;
+    Ok(close - open)
+}
+
+/// The camera's shutter interval (`shutteropen`, `shutterclose`; pbrt-v4's
+/// defaults 0 and 1): moving shapes are sampled over it.
+pub fn shutter(desc: &SceneDescription) -> Result<(f32, f32), BuildError> {
     let Some(c) = &desc.camera else {
-        return Ok(1.0);
+        return Ok((0.0, 1.0));
     };
     let open = c.params.get_float("shutteropen", 0.0)?;
     let close = c.params.get_float("shutterclose", 1.0)?;
@@ -95,7 +102,7 @@ fn camera_exposure(desc: &SceneDescription) -> Result<f32, BuildError> {
             "\"shutterclose\" is before \"shutteropen\"",
         ));
     }
-    Ok(close - open)
+    Ok((open, close))
 }
 
 /// Crop window / pixel bounds as pbrt-v4 computes them (half-open pixel range).

@@ -1,4 +1,8 @@
 //! Shapes and area lights (instances are flattened into world space).
+//!
+//! A shape whose transform differs at the start and end of `TransformTimes`
+//! (or that belongs to a moving instance) is built in object space and
+//! placed in a [`MovingGroup`] with its [`AnimatedTransform`].
 
 use super::lights::area_light;
 use super::materials::MaterialNames;
@@ -7,23 +11,66 @@ use super::textures::{Source, Textures};
 use super::BuildError;
 use crate::interaction::{LightId, MaterialId};
 use crate::light::Light;
-use crate::math::Transform;
-use crate::scene::Primitive;
+use crate::math::{AnimatedTransform, Transform};
+use crate::scene::{MovingGroup, Primitive};
 use crate::texture::FloatTexture;
 use candela_scene::{MaterialRef, SceneDescription, ShapeDesc};
 
-/// Primitives, their area lights, and the `Texture` directives alpha used.
-pub type Built = (Vec<Primitive>, Vec<Light>, Vec<bool>);
+/// Static primitives, moving groups, their area lights, and the `Texture`
+/// directives alpha used.
+pub struct Built {
+    /// Static primitives in world space.
+    pub prims: Vec<Primitive>,
+    /// Moving shapes.
+    pub movers: Vec<MovingGroup>,
+    /// Area lights of the static primitives.
+    pub lights: Vec<Light>,
+    /// Which `Texture` directives `alpha` parameters used.
+    pub textures_used: Vec<bool>,
+}
+
+/// Where a shape's parent places it: at the start time and, when moving, at
+/// the end time.
+struct Placement {
+    start: Transform,
+    end: Option<Transform>,
+    times: [f32; 2],
+}
+
+/// Shapes being collected.
+struct Sink {
+    prims: Vec<Primitive>,
+    movers: Vec<MovingGroup>,
+    lights: Vec<Light>,
+}
+
+fn transform(
+    m: &candela_scene::Mat4d,
+    loc: &candela_scene::Loc,
+    what: &str,
+) -> Result<Transform, BuildError> {
+    Transform::from_rows_f64(m.m)
+        .ok_or_else(|| BuildError::at(loc, format!("singular {what} transform")))
+}
 
 /// All primitives (instances flattened), the area lights they carry, and
 /// which `Texture` directives their `alpha` parameters used.
 pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Built, BuildError> {
-    let mut prims = Vec::new();
-    let mut lights = Vec::new();
+    let mut sink = Sink {
+        prims: Vec::new(),
+        movers: Vec::new(),
+        lights: Vec::new(),
+    };
     let mut tex = Textures::new(&desc.textures);
     let tex = &mut tex;
+    let times = desc.transform_times;
+    let world = Placement {
+        start: Transform::IDENTITY,
+        end: None,
+        times,
+    };
     for s in &desc.shapes {
-        add_shape(s, &Transform::IDENTITY, names, tex, &mut prims, &mut lights)?;
+        add_shape(s, &world, names, tex, &mut sink)?;
     }
     for inst in &desc.instances {
         let def = desc
@@ -36,26 +83,36 @@ pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Buil
                     format!("object instance \"{}\" was never defined", inst.name),
                 )
             })?;
-        let t = Transform::from_rows_f64(inst.render_from_instance.m)
-            .ok_or_else(|| BuildError::at(&inst.loc, "singular instance transform"))?;
+        let placement = Placement {
+            start: transform(&inst.render_from_instance, &inst.loc, "instance")?,
+            end: inst
+                .render_from_instance_end
+                .as_ref()
+                .map(|m| transform(m, &inst.loc, "instance"))
+                .transpose()?,
+            times,
+        };
         for s in &def.shapes {
             if let Some(a) = &s.area_light {
                 return Err(BuildError::at(&a.loc, "area lights inside object instances are not supported (pbrt-v4 rejects them too)"));
             }
-            add_shape(s, &t, names, tex, &mut prims, &mut lights)?;
+            add_shape(s, &placement, names, tex, &mut sink)?;
         }
     }
-    let used = tex.used().to_vec();
-    Ok((prims, lights, used))
+    Ok(Built {
+        prims: sink.prims,
+        movers: sink.movers,
+        lights: sink.lights,
+        textures_used: tex.used().to_vec(),
+    })
 }
 
 fn add_shape(
     s: &ShapeDesc,
-    parent: &Transform,
+    parent: &Placement,
     names: &MaterialNames,
     tex: &mut Textures,
-    prims: &mut Vec<Primitive>,
-    lights: &mut Vec<Light>,
+    sink: &mut Sink,
 ) -> Result<(), BuildError> {
     let material = match &s.material {
         MaterialRef::Index(i) => Some(MaterialId(*i as u32)),
@@ -65,10 +122,40 @@ fn add_shape(
         MaterialRef::None => Some(names.1),
     };
     let alpha = alpha(s, tex)?;
-    let object = Transform::from_rows_f64(s.render_from_object.m)
-        .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
-    let render_from_object = parent.then_after(&object);
+    let object = transform(&s.render_from_object, &s.loc, "shape")?;
+    let object_end = s
+        .render_from_object_end
+        .as_ref()
+        .map(|m| transform(m, &s.loc, "shape"))
+        .transpose()?;
+    let render_from_object = parent.start.then_after(&object);
+    if parent.end.is_some() || object_end.is_some() {
+        let end = parent
+            .end
+            .unwrap_or(parent.start)
+            .then_after(&object_end.unwrap_or(object));
+        if let Some(a) = &s.area_light {
+            return Err(BuildError::at(
+                &a.loc,
+                "an area light on a moving shape is not supported (pbrt-v4 does not animate area lights either)",
+            ));
+        }
+        let prims = build_shape(s, &Transform::IDENTITY)?
+            .into_iter()
+            .map(|shape| Primitive {
+                shape,
+                material,
+                area_light: None,
+                alpha: alpha.clone(),
+            })
+            .collect();
+        let [t0, t1] = parent.times;
+        let motion = AnimatedTransform::new(render_from_object, t0, end, t1);
+        sink.movers.push(MovingGroup::new(prims, motion));
+        return Ok(());
+    }
     let shapes = build_shape(s, &render_from_object)?;
+    let (prims, lights) = (&mut sink.prims, &mut sink.lights);
     prims.reserve(shapes.len());
     for shape in shapes {
         let area_light = match &s.area_light {

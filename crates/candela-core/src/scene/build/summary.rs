@@ -119,7 +119,12 @@ fn sampler_line(written: &str, setup: &RenderSetup) -> String {
 /// Summarizes the scene `desc` was built into.
 pub fn summarize(desc: &SceneDescription, setup: &RenderSetup) -> SceneSummary {
     let defs = desc.instance_definitions.iter().flat_map(|d| &d.shapes);
-    let prims = setup.scene.primitives();
+    let scene = &setup.scene;
+    let prims: Vec<_> = scene
+        .primitives()
+        .iter()
+        .chain(scene.moving_groups().iter().flat_map(|m| m.primitives()))
+        .collect();
     let triangles = prims
         .iter()
         .filter(|p| matches!(p.shape, Shape::Triangle(_)))
