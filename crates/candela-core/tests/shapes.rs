@@ -99,6 +99,36 @@ Shape "bilinearmesh" "point3 P" [3 -1 -1  3 1 -1  4 -1 1  3 1 1] "point2 uv" [0 
     assert!(si.p().normalize().dot(d) > 1.0 - 1e-6);
 }
 
+/// pbrt-v4 masks an area light's emission with the shape's alpha and skips
+/// alpha-0 surfaces when tracing, so `"float alpha" 0` switches an emitter off
+/// (kroken's lights.pbrt does this); other alpha on an emitter stays an error.
+#[test]
+fn emitter_with_alpha_zero_is_switched_off() {
+    let s = setup(
+        r#"AttributeBegin
+Translate 5 0 0
+AreaLightSource "diffuse" "rgb L" [50 50 50]
+Shape "sphere" "float radius" 1 "float alpha" 0
+AttributeEnd
+LightSource "point" "rgb I" [1 1 1]
+"#,
+    )
+    .expect("builds");
+    assert_eq!(s.scene.lights().len(), 1, "only the point light remains");
+    assert!(s
+        .scene
+        .intersect(&Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)), f32::INFINITY)
+        .is_none());
+    let err = setup(
+        r#"AreaLightSource "diffuse" "rgb L" [1 1 1]
+Shape "sphere" "float alpha" 0.5
+"#,
+    )
+    .err()
+    .expect("partial alpha on an emitter is rejected");
+    assert!(err.to_string().contains("shapes.pbrt:8:16"), "{err}");
+}
+
 #[test]
 fn loopsubdiv_is_built_and_hit() {
     let s = setup(

@@ -64,7 +64,12 @@ fn add_shape(
         })?),
         MaterialRef::None => Some(names.1),
     };
-    let alpha = alpha(s, tex)?;
+    let alpha = match alpha(s, tex)? {
+        // pbrt-v4 masks the emission by alpha and skips alpha-0 hits: the
+        // emitter neither shows nor lights anything, so it is left out.
+        Alpha::Off => return Ok(()),
+        Alpha::Mask(a) => a,
+    };
     let object = Transform::from_rows_f64(s.render_from_object.m)
         .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
     let render_from_object = parent.then_after(&object);
@@ -88,20 +93,27 @@ fn add_shape(
     Ok(())
 }
 
-/// pbrt-v4's `alpha` (float or float texture): `None` when the shape is
-/// fully opaque. Emitters with cut-outs are rejected (their emission would
-/// have to be masked too).
-fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Option<FloatTexture>, BuildError> {
+/// A shape's alpha: a mask (`None` when fully opaque), or `Off` for an
+/// emitter whose constant alpha is 0.
+enum Alpha {
+    Mask(Option<FloatTexture>),
+    Off,
+}
+
+/// pbrt-v4's `alpha` (float or float texture). Emitters with other cut-outs
+/// are rejected (their emission would have to be masked too).
+fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Alpha, BuildError> {
     let src = Source::new(&s.params, &s.loc, "srgb")?;
     let alpha = match tex.float_opt(&src, "alpha")? {
         Some(FloatTexture::Constant(a)) if a >= 1.0 => None,
         other => other,
     };
-    if alpha.is_some() && s.area_light.is_some() {
-        return Err(BuildError::at(
+    match (&alpha, &s.area_light) {
+        (Some(FloatTexture::Constant(a)), Some(_)) if *a <= 0.0 => Ok(Alpha::Off),
+        (Some(_), Some(_)) => Err(BuildError::at(
             s.params.param_loc("alpha").unwrap_or(&s.loc),
-            "\"alpha\" on an area light is not supported yet",
-        ));
+            "\"alpha\" on an area light is not supported yet (only 0, which switches it off)",
+        )),
+        _ => Ok(Alpha::Mask(alpha)),
     }
-    Ok(alpha)
 }
