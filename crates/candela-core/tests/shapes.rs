@@ -115,6 +115,7 @@ LightSource "point" "rgb I" [1 1 1]
     )
     .expect("builds");
     assert_eq!(s.scene.lights().len(), 1, "only the point light remains");
+    assert!(s.warnings.iter().all(|w| !w.contains("unused")), "{:?}", s.warnings);
     assert!(s
         .scene
         .intersect(&Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)), f32::INFINITY)

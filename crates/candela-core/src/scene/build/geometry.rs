@@ -64,16 +64,23 @@ fn add_shape(
         })?),
         MaterialRef::None => Some(names.1),
     };
-    let alpha = match alpha(s, tex)? {
-        // pbrt-v4 masks the emission by alpha and skips alpha-0 hits: the
-        // emitter neither shows nor lights anything, so it is left out.
-        Alpha::Off => return Ok(()),
-        Alpha::Mask(a) => a,
-    };
+    let alpha = alpha(s, tex)?;
     let object = Transform::from_rows_f64(s.render_from_object.m)
         .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
     let render_from_object = parent.then_after(&object);
     let shapes = build_shape(s, &render_from_object)?;
+    let alpha = match alpha {
+        // pbrt-v4 masks the emission by alpha and skips alpha-0 hits: the
+        // emitter neither shows nor lights anything, so it is left out
+        // (after its shape and light were checked like any other).
+        Alpha::Off => {
+            if let (Some(a), Some(shape)) = (&s.area_light, shapes.first()) {
+                area_light(a, shape, &s.loc)?;
+            }
+            return Ok(());
+        }
+        Alpha::Mask(a) => a,
+    };
     prims.reserve(shapes.len());
     for shape in shapes {
         let area_light = match &s.area_light {
