@@ -115,10 +115,17 @@ LightSource "point" "rgb I" [1 1 1]
     )
     .expect("builds");
     assert_eq!(s.scene.lights().len(), 1, "only the point light remains");
-    assert!(s.warnings.iter().all(|w| !w.contains("unused")), "{:?}", s.warnings);
+    assert!(
+        s.warnings.iter().all(|w| !w.contains("unused")),
+        "{:?}",
+        s.warnings
+    );
     assert!(s
         .scene
-        .intersect(&Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)), f32::INFINITY)
+        .intersect(
+            &Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)),
+            f32::INFINITY
+        )
         .is_none());
     let err = setup(
         r#"AreaLightSource "diffuse" "rgb L" [1 1 1]
@@ -128,6 +135,44 @@ Shape "sphere" "float alpha" 0.5
     .err()
     .expect("partial alpha on an emitter is rejected");
     assert!(err.to_string().contains("shapes.pbrt:8:16"), "{err}");
+}
+
+/// A singular CTM is valid pbrt-v4 input (exporters write zero scales for
+/// hidden objects, as transparent-machines does): the scene builds, the
+/// flattened shape and instance are left out with a warning at their place,
+/// and their parameters are not reported as unused.
+#[test]
+fn shapes_under_a_singular_transform_are_skipped_with_a_warning() {
+    let s = setup(
+        r#"ObjectBegin "bolt"
+Shape "sphere" "float radius" 1
+ObjectEnd
+AttributeBegin
+ConcatTransform [ 0 0 0 0  0 1 0 0  0 0 1 0  5 0 0 1 ]
+Shape "sphere" "float radius" 2
+ObjectInstance "bolt"
+AttributeEnd
+AttributeBegin
+Translate 5 0 0
+Shape "sphere" "float radius" 0.5
+AttributeEnd
+"#,
+    )
+    .expect("builds");
+    assert_eq!(s.scene.primitives().len(), 1, "only the regular sphere");
+    let singular: Vec<_> = s
+        .warnings
+        .iter()
+        .filter(|w| w.contains("singular"))
+        .collect();
+    assert_eq!(singular.len(), 2, "{:?}", s.warnings);
+    assert!(singular[0].contains("shapes.pbrt:12:1"), "{singular:?}");
+    assert!(singular[1].contains("shapes.pbrt:13:1"), "{singular:?}");
+    assert!(
+        s.warnings.iter().all(|w| !w.contains("unused")),
+        "{:?}",
+        s.warnings
+    );
 }
 
 #[test]

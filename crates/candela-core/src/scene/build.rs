@@ -119,7 +119,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         ));
     }
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
-    let (primitives, mut lights, alpha_used) = geometry::primitives(desc, &names)?;
+    let (primitives, mut lights, alpha_used) = geometry::primitives(desc, &names, &mut warnings)?;
     let textures_used: Vec<bool> = textures_used
         .iter()
         .zip(&alpha_used)

@@ -16,14 +16,27 @@ use candela_scene::{MaterialRef, SceneDescription, ShapeDesc};
 pub type Built = (Vec<Primitive>, Vec<Light>, Vec<bool>);
 
 /// All primitives (instances flattened), the area lights they carry, and
-/// which `Texture` directives their `alpha` parameters used.
-pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Built, BuildError> {
+/// which `Texture` directives their `alpha` parameters used. Shapes and
+/// instances under a singular CTM are left out with a warning.
+pub fn primitives(
+    desc: &SceneDescription,
+    names: &MaterialNames,
+    warnings: &mut Vec<String>,
+) -> Result<Built, BuildError> {
     let mut prims = Vec::new();
     let mut lights = Vec::new();
     let mut tex = Textures::new(&desc.textures);
     let tex = &mut tex;
     for s in &desc.shapes {
-        add_shape(s, &Transform::IDENTITY, names, tex, &mut prims, &mut lights)?;
+        add_shape(
+            s,
+            &Transform::IDENTITY,
+            names,
+            tex,
+            &mut prims,
+            &mut lights,
+            warnings,
+        )?;
     }
     for inst in &desc.instances {
         let def = desc
@@ -36,13 +49,16 @@ pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Buil
                     format!("object instance \"{}\" was never defined", inst.name),
                 )
             })?;
-        let t = Transform::from_rows_f64(inst.render_from_instance.m)
-            .ok_or_else(|| BuildError::at(&inst.loc, "singular instance transform"))?;
+        let Some(t) = Transform::from_rows_f64(inst.render_from_instance.m) else {
+            warnings.push(singular(&inst.loc, "object instance"));
+            def.shapes.iter().for_each(|s| s.params.mark_all_used());
+            continue;
+        };
         for s in &def.shapes {
             if let Some(a) = &s.area_light {
                 return Err(BuildError::at(&a.loc, "area lights inside object instances are not supported (pbrt-v4 rejects them too)"));
             }
-            add_shape(s, &t, names, tex, &mut prims, &mut lights)?;
+            add_shape(s, &t, names, tex, &mut prims, &mut lights, warnings)?;
         }
     }
     let used = tex.used().to_vec();
@@ -56,6 +72,7 @@ fn add_shape(
     tex: &mut Textures,
     prims: &mut Vec<Primitive>,
     lights: &mut Vec<Light>,
+    warnings: &mut Vec<String>,
 ) -> Result<(), BuildError> {
     let material = match &s.material {
         MaterialRef::Index(i) => Some(MaterialId(*i as u32)),
@@ -64,9 +81,15 @@ fn add_shape(
         })?),
         MaterialRef::None => Some(names.1),
     };
+    let Some(object) = Transform::from_rows_f64(s.render_from_object.m) else {
+        warnings.push(singular(&s.loc, "shape"));
+        s.params.mark_all_used();
+        if let Some(a) = &s.area_light {
+            a.params.mark_all_used();
+        }
+        return Ok(());
+    };
     let alpha = alpha(s, tex)?;
-    let object = Transform::from_rows_f64(s.render_from_object.m)
-        .ok_or_else(|| BuildError::at(&s.loc, "singular shape transform"))?;
     let render_from_object = parent.then_after(&object);
     let shapes = build_shape(s, &render_from_object)?;
     let alpha = match alpha {
@@ -98,6 +121,13 @@ fn add_shape(
         });
     }
     Ok(())
+}
+
+/// The warning for an entity left out because its CTM is singular (pbrt-v4
+/// accepts such transforms and flattens the shape; exporters use a zero
+/// scale to hide objects).
+fn singular(loc: &candela_scene::Loc, what: &str) -> String {
+    format!("{loc}: {what} under a singular (zero-scale) transform is left out; pbrt-v4 would render it flattened")
 }
 
 /// A shape's alpha: a mask (`None` when fully opaque), or `Off` for an
