@@ -99,6 +99,82 @@ Shape "bilinearmesh" "point3 P" [3 -1 -1  3 1 -1  4 -1 1  3 1 1] "point2 uv" [0 
     assert!(si.p().normalize().dot(d) > 1.0 - 1e-6);
 }
 
+/// pbrt-v4 masks an area light's emission with the shape's alpha and skips
+/// alpha-0 surfaces when tracing, so `"float alpha" 0` switches an emitter off
+/// (kroken's lights.pbrt does this); other alpha on an emitter stays an error.
+#[test]
+fn emitter_with_alpha_zero_is_switched_off() {
+    let s = setup(
+        r#"AttributeBegin
+Translate 5 0 0
+AreaLightSource "diffuse" "rgb L" [50 50 50]
+Shape "sphere" "float radius" 1 "float alpha" 0
+AttributeEnd
+LightSource "point" "rgb I" [1 1 1]
+"#,
+    )
+    .expect("builds");
+    assert_eq!(s.scene.lights().len(), 1, "only the point light remains");
+    assert!(
+        s.warnings.iter().all(|w| !w.contains("unused")),
+        "{:?}",
+        s.warnings
+    );
+    assert!(s
+        .scene
+        .intersect(
+            &Ray::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)),
+            f32::INFINITY
+        )
+        .is_none());
+    let err = setup(
+        r#"AreaLightSource "diffuse" "rgb L" [1 1 1]
+Shape "sphere" "float alpha" 0.5
+"#,
+    )
+    .err()
+    .expect("partial alpha on an emitter is rejected");
+    assert!(err.to_string().contains("shapes.pbrt:8:16"), "{err}");
+}
+
+/// A singular CTM is valid pbrt-v4 input (exporters write zero scales for
+/// hidden objects, as transparent-machines does): the scene builds, the
+/// flattened shape and instance are left out with a warning at their place,
+/// and their parameters are not reported as unused.
+#[test]
+fn shapes_under_a_singular_transform_are_skipped_with_a_warning() {
+    let s = setup(
+        r#"ObjectBegin "bolt"
+Shape "sphere" "float radius" 1
+ObjectEnd
+AttributeBegin
+ConcatTransform [ 0 0 0 0  0 1 0 0  0 0 1 0  5 0 0 1 ]
+Shape "sphere" "float radius" 2
+ObjectInstance "bolt"
+AttributeEnd
+AttributeBegin
+Translate 5 0 0
+Shape "sphere" "float radius" 0.5
+AttributeEnd
+"#,
+    )
+    .expect("builds");
+    assert_eq!(s.scene.primitives().len(), 1, "only the regular sphere");
+    let singular: Vec<_> = s
+        .warnings
+        .iter()
+        .filter(|w| w.contains("singular"))
+        .collect();
+    assert_eq!(singular.len(), 2, "{:?}", s.warnings);
+    assert!(singular[0].contains("shapes.pbrt:12:1"), "{singular:?}");
+    assert!(singular[1].contains("shapes.pbrt:13:1"), "{singular:?}");
+    assert!(
+        s.warnings.iter().all(|w| !w.contains("unused")),
+        "{:?}",
+        s.warnings
+    );
+}
+
 #[test]
 fn loopsubdiv_is_built_and_hit() {
     let s = setup(

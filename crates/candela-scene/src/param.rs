@@ -202,6 +202,14 @@ impl ParamSet {
         SceneError::at(self.param_loc(name).unwrap_or(fallback), message)
     }
 
+    /// Marks every parameter read, for an entity that is deliberately left
+    /// out (its parameters are then not "unused").
+    pub fn mark_all_used(&self) {
+        for p in &self.params {
+            p.used.set(true);
+        }
+    }
+
     /// Parameters never read by a getter (and not inherited defaults).
     pub fn unused(&self) -> Vec<(&str, &Loc)> {
         self.params

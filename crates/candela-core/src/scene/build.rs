@@ -124,7 +124,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         movers,
         mut lights,
         textures_used: alpha_used,
-    } = geometry::primitives(desc, &names)?;
+    } = geometry::primitives(desc, &names, &mut warnings)?;
     let textures_used: Vec<bool> = textures_used
         .iter()
         .zip(&alpha_used)

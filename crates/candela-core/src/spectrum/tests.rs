@@ -148,6 +148,10 @@ fn named_glasses_and_metals() {
         ("glass-BAF10", 1.6700),
         ("glass-FK51A", 1.4866),
         ("glass-LASF9", 1.8503),
+        // pbrt-v4's names for Schott SF5, SF10 and SF11 (catalogue n_d)
+        ("glass-F5", 1.6727),
+        ("glass-F10", 1.7283),
+        ("glass-F11", 1.7847),
     ] {
         let n = named_spectrum(name).unwrap().eval(587.6);
         assert!((n - nd).abs() < 1e-3, "{name}: {n} vs {nd}");

@@ -54,8 +54,13 @@ fn transform(
 }
 
 /// All primitives (instances flattened), the area lights they carry, and
-/// which `Texture` directives their `alpha` parameters used.
-pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Built, BuildError> {
+/// which `Texture` directives their `alpha` parameters used. Shapes and
+/// instances under a singular CTM are left out with a warning.
+pub fn primitives(
+    desc: &SceneDescription,
+    names: &MaterialNames,
+    warnings: &mut Vec<String>,
+) -> Result<Built, BuildError> {
     let mut sink = Sink {
         prims: Vec::new(),
         movers: Vec::new(),
@@ -70,7 +75,7 @@ pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Buil
         times,
     };
     for s in &desc.shapes {
-        add_shape(s, &world, names, tex, &mut sink)?;
+        add_shape(s, &world, names, tex, &mut sink, warnings)?;
     }
     for inst in &desc.instances {
         let def = desc
@@ -83,8 +88,13 @@ pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Buil
                     format!("object instance \"{}\" was never defined", inst.name),
                 )
             })?;
+        let Some(start) = Transform::from_rows_f64(inst.render_from_instance.m) else {
+            warnings.push(singular(&inst.loc, "object instance"));
+            def.shapes.iter().for_each(|s| s.params.mark_all_used());
+            continue;
+        };
         let placement = Placement {
-            start: transform(&inst.render_from_instance, &inst.loc, "instance")?,
+            start,
             end: inst
                 .render_from_instance_end
                 .as_ref()
@@ -96,7 +106,7 @@ pub fn primitives(desc: &SceneDescription, names: &MaterialNames) -> Result<Buil
             if let Some(a) = &s.area_light {
                 return Err(BuildError::at(&a.loc, "area lights inside object instances are not supported (pbrt-v4 rejects them too)"));
             }
-            add_shape(s, &placement, names, tex, &mut sink)?;
+            add_shape(s, &placement, names, tex, &mut sink, warnings)?;
         }
     }
     Ok(Built {
@@ -113,6 +123,7 @@ fn add_shape(
     names: &MaterialNames,
     tex: &mut Textures,
     sink: &mut Sink,
+    warnings: &mut Vec<String>,
 ) -> Result<(), BuildError> {
     let material = match &s.material {
         MaterialRef::Index(i) => Some(MaterialId(*i as u32)),
@@ -121,8 +132,15 @@ fn add_shape(
         })?),
         MaterialRef::None => Some(names.1),
     };
+    let Some(object) = Transform::from_rows_f64(s.render_from_object.m) else {
+        warnings.push(singular(&s.loc, "shape"));
+        s.params.mark_all_used();
+        if let Some(a) = &s.area_light {
+            a.params.mark_all_used();
+        }
+        return Ok(());
+    };
     let alpha = alpha(s, tex)?;
-    let object = transform(&s.render_from_object, &s.loc, "shape")?;
     let object_end = s
         .render_from_object_end
         .as_ref()
@@ -140,6 +158,9 @@ fn add_shape(
                 "an area light on a moving shape is not supported (pbrt-v4 does not animate area lights either)",
             ));
         }
+        let Alpha::Mask(alpha) = alpha else {
+            return Ok(()); // Switched off (only emitters, refused above).
+        };
         let prims = build_shape(s, &Transform::IDENTITY)?
             .into_iter()
             .map(|shape| Primitive {
@@ -155,6 +176,18 @@ fn add_shape(
         return Ok(());
     }
     let shapes = build_shape(s, &render_from_object)?;
+    let alpha = match alpha {
+        // pbrt-v4 masks the emission by alpha and skips alpha-0 hits: the
+        // emitter neither shows nor lights anything, so it is left out
+        // (after its shape and light were checked like any other).
+        Alpha::Off => {
+            if let (Some(a), Some(shape)) = (&s.area_light, shapes.first()) {
+                area_light(a, shape, &s.loc)?;
+            }
+            return Ok(());
+        }
+        Alpha::Mask(a) => a,
+    };
     let (prims, lights) = (&mut sink.prims, &mut sink.lights);
     prims.reserve(shapes.len());
     for shape in shapes {
@@ -175,20 +208,34 @@ fn add_shape(
     Ok(())
 }
 
-/// pbrt-v4's `alpha` (float or float texture): `None` when the shape is
-/// fully opaque. Emitters with cut-outs are rejected (their emission would
-/// have to be masked too).
-fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Option<FloatTexture>, BuildError> {
+/// The warning for an entity left out because its CTM is singular (pbrt-v4
+/// accepts such transforms and flattens the shape; exporters use a zero
+/// scale to hide objects).
+fn singular(loc: &candela_scene::Loc, what: &str) -> String {
+    format!("{loc}: {what} under a singular (zero-scale) transform is left out; pbrt-v4 would render it flattened")
+}
+
+/// A shape's alpha: a mask (`None` when fully opaque), or `Off` for an
+/// emitter whose constant alpha is 0.
+enum Alpha {
+    Mask(Option<FloatTexture>),
+    Off,
+}
+
+/// pbrt-v4's `alpha` (float or float texture). Emitters with other cut-outs
+/// are rejected (their emission would have to be masked too).
+fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Alpha, BuildError> {
     let src = Source::new(&s.params, &s.loc, "srgb")?;
     let alpha = match tex.float_opt(&src, "alpha")? {
         Some(FloatTexture::Constant(a)) if a >= 1.0 => None,
         other => other,
     };
-    if alpha.is_some() && s.area_light.is_some() {
-        return Err(BuildError::at(
+    match (&alpha, &s.area_light) {
+        (Some(FloatTexture::Constant(a)), Some(_)) if *a <= 0.0 => Ok(Alpha::Off),
+        (Some(_), Some(_)) => Err(BuildError::at(
             s.params.param_loc("alpha").unwrap_or(&s.loc),
-            "\"alpha\" on an area light is not supported yet",
-        ));
+            "\"alpha\" on an area light is not supported yet (only 0, which switches it off)",
+        )),
+        _ => Ok(Alpha::Mask(alpha)),
     }
-    Ok(alpha)
 }
