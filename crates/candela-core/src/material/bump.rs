@@ -11,10 +11,57 @@
 //! or 0.0005 without screen-space differentials (candela's case for now).
 //! The shading normal becomes ∂p′/∂u × ∂p′/∂v, turned to the geometric
 //! normal's side.
+//!
+//! Normal mapping (pbrt-v4's `normalmap` material parameter, book §10.5.2)
+//! instead reads the shading normal from an RGB image in tangent space:
+//! n_t = 2·rgb − 1 at (u, 1 − v), bilinearly filtered with repeat wrapping,
+//! expressed in the frame whose x follows ∂p/∂u and whose z is the shading
+//! normal. ∂p/∂u is then made perpendicular to n_t (Gram–Schmidt) keeping its
+//! length, and ∂p/∂v = n_t × ∂p/∂u keeps its own, so the new shading normal
+//! ∂p/∂u × ∂p/∂v is n_t. When a material has both, the normal map wins, as in
+//! pbrt-v4.
 
+use crate::image::{MapImage, WrapMode};
 use crate::interaction::SurfaceInteraction;
-use crate::math::{Vec2, Vec3};
+use crate::math::{Frame, Vec2, Vec3};
 use crate::texture::{FloatTexture, TextureEvalContext};
+use std::sync::Arc;
+
+/// How a material perturbs the shading normal.
+#[derive(Clone, Debug)]
+pub enum Bump {
+    /// A scalar displacement texture (bump mapping).
+    Displacement(FloatTexture),
+    /// A tangent-space normal map: a linear RGB image.
+    NormalMap(Arc<MapImage>),
+}
+
+impl Bump {
+    /// Replaces the hit's shading geometry by the perturbed one.
+    pub fn apply(&self, si: &mut SurfaceInteraction) {
+        let (dpdu, dpdv) = match self {
+            Bump::Displacement(d) => bump_map(si, |ctx| d.evaluate(ctx)),
+            Bump::NormalMap(image) => normal_map(si, image),
+        };
+        set_shading(si, dpdu, dpdv);
+    }
+}
+
+/// The shading ∂p/∂u and ∂p/∂v whose cross product is the mapped normal.
+pub fn normal_map(si: &SurfaceInteraction, image: &MapImage) -> (Vec3, Vec3) {
+    let sh = &si.shading;
+    let st = Vec2::new(si.it.uv.x, 1.0 - si.it.uv.y);
+    let [r, g, b] = std::array::from_fn(|c| 2.0 * image.bilerp(st, c, WrapMode::Repeat) - 1.0);
+    let local = Vec3::new(r, g, b).normalize_or_zero();
+    if local == Vec3::ZERO {
+        return (sh.dpdu, sh.dpdv);
+    }
+    let ns = Frame::from_xz(sh.dpdu.normalize_or_zero(), sh.n).from_local(local);
+    let (ulen, vlen) = (sh.dpdu.length(), sh.dpdv.length());
+    let dpdu = (sh.dpdu - ns * ns.dot(sh.dpdu)).normalize_or_zero() * ulen;
+    let dpdv = ns.cross(dpdu).normalize_or_zero() * vlen;
+    (dpdu, dpdv)
+}
 
 /// Finite-difference step used when the hit has no (u, v) differentials [pbrt-v4].
 const DEFAULT_STEP: f32 = 0.0005;
@@ -49,6 +96,11 @@ pub fn bump_map(si: &SurfaceInteraction, d: impl Fn(&TextureEvalContext) -> f32)
 /// Replaces the hit's shading geometry by the bump-mapped one.
 pub fn apply_bump(si: &mut SurfaceInteraction, displacement: &FloatTexture) {
     let (dpdu, dpdv) = bump_map(si, |ctx| displacement.evaluate(ctx));
+    set_shading(si, dpdu, dpdv);
+}
+
+/// Shading geometry with normal ∂p/∂u × ∂p/∂v (unchanged if degenerate).
+fn set_shading(si: &mut SurfaceInteraction, dpdu: Vec3, dpdv: Vec3) {
     let ns = dpdu.cross(dpdv).normalize_or_zero();
     if ns == Vec3::ZERO || !ns.is_finite() {
         return;
@@ -119,5 +171,47 @@ mod tests {
         let want = Vec3::new(-0.5, 0.0, -1.0).normalize();
         assert!((si.shading.n - want).length() < 1e-3, "{}", si.shading.n);
         assert_eq!(si.n(), -Vec3::Z);
+    }
+
+    /// The map is read at (u, 1 − v) (row 0 at the top of the image), in the
+    /// frame x = ∂p/∂u, z = n: texels tilting towards +x in the top half and
+    /// towards −y in the bottom half turn the shading normal that way where
+    /// v is high and low respectively, keeping |∂p/∂u| and |∂p/∂v|.
+    #[test]
+    fn normal_map_reads_upright_in_the_tangent_frame() {
+        use crate::image::{MapImage, PixelFormat};
+        let (s, c) = (0.6f32, 0.8f32);
+        let up = [0.5 * (s + 1.0), 0.5, 0.5 * (c + 1.0)];
+        let down = [0.5, 0.5 * (1.0 - s), 0.5 * (c + 1.0)];
+        let data = [up, up, down, down].concat();
+        let image = MapImage {
+            width: 1,
+            height: 4,
+            channels: 3,
+            data,
+            format: PixelFormat::Float,
+        };
+        let hit = |v: f32| {
+            let mut si = SurfaceInteraction::new(
+                Vec3::ZERO,
+                Vec3::ZERO,
+                Vec2::new(0.5, v),
+                Vec3::Z,
+                2.0 * Vec3::X,
+                3.0 * Vec3::Y,
+                Vec3::ZERO,
+                Vec3::ZERO,
+                false,
+            );
+            Bump::NormalMap(Arc::new(image.clone())).apply(&mut si);
+            si
+        };
+        for (v, want) in [(0.8, Vec3::new(s, 0.0, c)), (0.2, Vec3::new(0.0, -s, c))] {
+            let si = hit(v);
+            let sh = si.shading;
+            assert!(sh.n.distance(want) < 1e-5, "v = {v}: {} vs {want}", sh.n);
+            assert!((sh.dpdu.length() - 2.0).abs() < 1e-5 && sh.dpdu.dot(sh.n).abs() < 1e-5);
+            assert!((sh.dpdv.length() - 3.0).abs() < 1e-5);
+        }
     }
 }

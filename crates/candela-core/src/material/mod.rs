@@ -9,13 +9,13 @@
 //! stochastic layered BxDF of pbrt-v4 §14.3.
 //!
 //! The scene resolves a [`Material::Mix`] to one of its materials per hit
-//! ([`mix_choice`]) and applies a material's `displacement` ([`apply_bump`])
+//! ([`mix_choice`]) and applies a material's `displacement` or `normalmap` ([`Bump::apply`])
 //! before asking it for a BSDF, as pbrt-v4's `SurfaceInteraction::GetBSDF`.
 
 mod bump;
 mod mix;
 
-pub use bump::{apply_bump, bump_map};
+pub use bump::{apply_bump, bump_map, normal_map, Bump};
 pub use mix::mix_choice;
 
 use crate::bsdf::{
@@ -113,7 +113,7 @@ pub enum Material {
         /// Albedo.
         reflectance: SpectrumTexture,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Metal.
     Conductor {
@@ -122,7 +122,7 @@ pub enum Material {
         /// Microfacet roughness.
         roughness: Roughness,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Glass-like boundary.
     Dielectric {
@@ -131,14 +131,14 @@ pub enum Material {
         /// Microfacet roughness.
         roughness: Roughness,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Thin dielectric sheet.
     ThinDielectric {
         /// Index of refraction.
         eta: Spectrum,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Lambertian reflection and transmission.
     DiffuseTransmission {
@@ -149,7 +149,7 @@ pub enum Material {
         /// Factor on both.
         scale: f32,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Dielectric coating over a Lambertian base.
     CoatedDiffuse {
@@ -158,7 +158,7 @@ pub enum Material {
         /// Coating and medium.
         coating: Coating,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Dielectric coating over a metal.
     CoatedConductor {
@@ -169,7 +169,7 @@ pub enum Material {
         /// Coating and medium.
         coating: Coating,
         /// Bump map.
-        displacement: Option<FloatTexture>,
+        bump: Option<Bump>,
     },
     /// Marks a boundary without scattering (media transitions).
     Interface,
@@ -245,16 +245,16 @@ impl Material {
         Some(Bsdf::new(si.shading.n, si.shading.dpdu, bxdf))
     }
 
-    /// The bump map, if any.
-    pub fn displacement(&self) -> Option<&FloatTexture> {
+    /// The bump or normal map, if any.
+    pub fn bump(&self) -> Option<&Bump> {
         match self {
-            Material::Diffuse { displacement, .. }
-            | Material::Conductor { displacement, .. }
-            | Material::Dielectric { displacement, .. }
-            | Material::ThinDielectric { displacement, .. }
-            | Material::DiffuseTransmission { displacement, .. }
-            | Material::CoatedDiffuse { displacement, .. }
-            | Material::CoatedConductor { displacement, .. } => displacement.as_ref(),
+            Material::Diffuse { bump, .. }
+            | Material::Conductor { bump, .. }
+            | Material::Dielectric { bump, .. }
+            | Material::ThinDielectric { bump, .. }
+            | Material::DiffuseTransmission { bump, .. }
+            | Material::CoatedDiffuse { bump, .. }
+            | Material::CoatedConductor { bump, .. } => bump.as_ref(),
             Material::Interface | Material::Mix { .. } => None,
         }
     }

@@ -12,7 +12,7 @@ use crate::accel::Bvh;
 use crate::bsdf::Bsdf;
 use crate::interaction::{Interaction, LightId, SurfaceInteraction};
 use crate::light::{Light, LightSampler};
-use crate::material::{apply_bump, mix_choice, Material};
+use crate::material::{mix_choice, Material};
 use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
 use crate::shape::WatertightRay;
 use crate::spectrum::SampledWavelengths;
@@ -221,8 +221,8 @@ impl Scene {
         lambda: &mut SampledWavelengths,
     ) -> Option<Bsdf> {
         let m = self.resolve_material(si)?;
-        if let Some(d) = m.displacement() {
-            apply_bump(si, d);
+        if let Some(b) = m.bump() {
+            b.apply(si);
         }
         m.bsdf(si, lambda)
     }

@@ -4,7 +4,7 @@
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::textures::{Source, Textures};
 use super::BuildError;
-use crate::material::{Coating, ConductorSpec, Material, Roughness};
+use crate::material::{Bump, Coating, ConductorSpec, Material, Roughness};
 use crate::spectrum::{named_spectrum, Spectrum};
 use crate::texture::{FloatTexture, SpectrumTexture};
 use candela_scene::ParamType;
@@ -103,12 +103,12 @@ pub fn conductor_spec(
 pub fn coated_diffuse(
     src: &Source,
     tex: &mut Textures,
-    displacement: Option<FloatTexture>,
+    bump: Option<Bump>,
 ) -> Result<Material, BuildError> {
     Ok(Material::CoatedDiffuse {
         reflectance: tex.spectrum(src, "reflectance", SpectrumKind::Albedo, 0.5)?,
         coating: coating(src, tex, "")?,
-        displacement,
+        bump,
     })
 }
 
@@ -116,12 +116,12 @@ pub fn coated_diffuse(
 pub fn coated_conductor(
     src: &Source,
     tex: &mut Textures,
-    displacement: Option<FloatTexture>,
+    bump: Option<Bump>,
 ) -> Result<Material, BuildError> {
     Ok(Material::CoatedConductor {
         spec: conductor_spec(src, tex, "conductor.eta", "conductor.k")?,
         roughness: roughness(src, tex, "conductor.")?,
         coating: coating(src, tex, "interface.")?,
-        displacement,
+        bump,
     })
 }

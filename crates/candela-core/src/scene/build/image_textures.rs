@@ -27,6 +27,7 @@ type Loaded = (Arc<MapImage>, &'static ColorSpace);
 #[derive(Default)]
 pub struct ImageCache {
     loaded: HashMap<(PathBuf, WrapMode, String), Loaded>,
+    normal_maps: HashMap<PathBuf, Arc<MapImage>>,
     /// Non-fatal problems met while loading or reading parameters.
     pub warnings: Vec<String>,
 }
@@ -91,6 +92,39 @@ impl ImageCache {
             invert: p.get_bool("invert", false)?,
             color_space,
         })
+    }
+
+    /// A normal map: read with linear encoding (pbrt-v4 reads normal maps
+    /// as `ColorEncoding::Linear`), not resized, RGB required.
+    pub fn normal_map(
+        &mut self,
+        path: PathBuf,
+        loc: &candela_scene::Loc,
+    ) -> Result<Arc<MapImage>, BuildError> {
+        if let Some(image) = self.normal_maps.get(&path) {
+            return Ok(image.clone());
+        }
+        if !path.is_file() {
+            return Err(BuildError::at(
+                loc,
+                format!("normal map \"{}\" not found", path.display()),
+            ));
+        }
+        let file = read_map(&path, ColorEncoding::Linear)
+            .map_err(|e| BuildError::at(loc, e.to_string()))?;
+        if file.image.channels != 3 {
+            return Err(BuildError::at(
+                loc,
+                format!(
+                    "normal map \"{}\" must have R, G and B channels (it has {})",
+                    path.display(),
+                    file.image.channels
+                ),
+            ));
+        }
+        let image = Arc::new(file.image);
+        self.normal_maps.insert(path, image.clone());
+        Ok(image)
     }
 
     /// The image at `path` resized for `wrap`, loaded on first request.

@@ -11,7 +11,7 @@ use super::spectra::SpectrumKind;
 use super::textures::{Source, Textures};
 use super::BuildError;
 use crate::interaction::MaterialId;
-use crate::material::{Material, Roughness};
+use crate::material::{Bump, Material, Roughness};
 use crate::spectrum::Spectrum;
 use crate::texture::{FloatTexture, SpectrumTexture};
 use candela_scene::{MaterialDesc, SceneDescription};
@@ -47,7 +47,7 @@ pub fn materials(
     let default = MaterialId(out.len() as u32);
     out.push(Material::Diffuse {
         reflectance: SpectrumTexture::Constant(Spectrum::Constant(0.5)),
-        displacement: None,
+        bump: None,
     });
     let used = textures.used().to_vec();
     warnings.extend_from_slice(textures.warnings());
@@ -74,48 +74,54 @@ fn eta(src: &Source) -> Result<Spectrum, BuildError> {
     eta_param(src, "eta")
 }
 
+/// The material's `normalmap` (an RGB image file, read linearly) or, without
+/// one, its `displacement` texture; pbrt-v4 prefers the normal map.
+fn bump(src: &Source, tex: &mut Textures) -> Result<Option<Bump>, BuildError> {
+    let displacement = tex.float_opt(src, "displacement")?;
+    let Some(path) = src.params.get_filename("normalmap")? else {
+        return Ok(displacement.map(Bump::Displacement));
+    };
+    let loc = src.params.param_loc("normalmap").unwrap_or(src.loc);
+    Ok(Some(Bump::NormalMap(tex.normal_map(path, loc)?)))
+}
+
 fn material(
     m: &MaterialDesc,
     tex: &mut Textures,
     names: &HashMap<String, MaterialId>,
 ) -> Result<Material, BuildError> {
     let src = Source::new(&m.params, &m.loc, &m.color_space)?;
-    if m.params.get_texture("normalmap").is_some()
-        || !m.params.get_string("normalmap", "")?.is_empty()
-    {
-        return Err(BuildError::at(&m.loc, "\"normalmap\" is not supported yet"));
-    }
-    let displacement = match m.ty.as_str() {
+    let bump = match m.ty.as_str() {
         "mix" | "interface" | "" | "none" => None,
-        _ => tex.float_opt(&src, "displacement")?,
+        _ => bump(&src, tex)?,
     };
     Ok(match m.ty.as_str() {
         "diffuse" => Material::Diffuse {
             reflectance: tex.spectrum(&src, "reflectance", SpectrumKind::Albedo, 0.5)?,
-            displacement,
+            bump,
         },
         "conductor" => Material::Conductor {
             spec: conductor_spec(&src, tex, "eta", "k")?,
             roughness: roughness(&src, tex)?,
-            displacement,
+            bump,
         },
         "dielectric" => Material::Dielectric {
             eta: eta(&src)?,
             roughness: roughness(&src, tex)?,
-            displacement,
+            bump,
         },
         "thindielectric" => Material::ThinDielectric {
             eta: eta(&src)?,
-            displacement,
+            bump,
         },
         "diffusetransmission" => Material::DiffuseTransmission {
             reflectance: tex.spectrum(&src, "reflectance", SpectrumKind::Albedo, 0.25)?,
             transmittance: tex.spectrum(&src, "transmittance", SpectrumKind::Albedo, 0.25)?,
             scale: src.params.get_float("scale", 1.0)?,
-            displacement,
+            bump,
         },
-        "coateddiffuse" => coated_diffuse(&src, tex, displacement)?,
-        "coatedconductor" => coated_conductor(&src, tex, displacement)?,
+        "coateddiffuse" => coated_diffuse(&src, tex, bump)?,
+        "coatedconductor" => coated_conductor(&src, tex, bump)?,
         "mix" => mix(&src, tex, names)?,
         "interface" | "" | "none" => Material::Interface,
         other => return Err(BuildError::at(&m.loc, format!("material \"{other}\" is not supported yet (supported: diffuse, diffusetransmission, conductor, coateddiffuse, coatedconductor, dielectric, thindielectric, mix, interface)"))),

@@ -101,6 +101,15 @@ impl<'a> Textures<'a> {
         &self.images.warnings
     }
 
+    /// The normal map image at `path`, loaded once.
+    pub fn normal_map(
+        &mut self,
+        path: std::path::PathBuf,
+        loc: &candela_scene::Loc,
+    ) -> Result<Arc<crate::image::MapImage>, BuildError> {
+        self.images.normal_map(path, loc)
+    }
+
     /// Which textures were referenced (directly or through other textures).
     pub fn used(&self) -> &[bool] {
         &self.used
