@@ -108,7 +108,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .iter()
         .map(|w| format!("{}: {}", w.loc, w.message))
         .collect();
-    let (film, outfile) = entities::film(desc, ov)?;
+    let (film, outfile) = entities::film(desc, ov, &mut warnings)?;
     let camera = entities::camera(desc, &film)?;
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let (integrator, integrator_name, power_sampling) =

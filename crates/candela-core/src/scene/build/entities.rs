@@ -25,19 +25,34 @@ fn transform(
 }
 
 /// The film and the output path (`--outfile` over `"string filename"`).
-pub fn film(desc: &SceneDescription, ov: &Overrides) -> Result<(RgbFilm, PathBuf), BuildError> {
+pub fn film(
+    desc: &SceneDescription,
+    ov: &Overrides,
+    warnings: &mut Vec<String>,
+) -> Result<(RgbFilm, PathBuf), BuildError> {
     let empty = super::default_entity("rgb");
     let e = desc.film.as_ref().unwrap_or(&empty);
-    if e.name != "rgb" {
-        return Err(BuildError::at(
-            &e.loc,
-            format!(
-                "film \"{}\" is not supported yet (supported: \"rgb\")",
-                e.name
-            ),
-        ));
-    }
     let p = &e.params;
+    match e.name.as_str() {
+        "rgb" => {}
+        // Same RGB image as "rgb"; the extra outputs are left out.
+        "gbuffer" => {
+            let _ = p.get_string("coordinatesystem", "camera")?;
+            warnings.push(format!("{}: film \"gbuffer\" is written as \"rgb\": the auxiliary channels (albedo, normals, depth, variance) are not written", e.loc));
+        }
+        "spectral" => {
+            let _ = p.get_int("nbuckets", 16)?;
+            let _ = p.get_float("lambdamin", 360.0)?;
+            let _ = p.get_float("lambdamax", 830.0)?;
+            warnings.push(format!("{}: film \"spectral\" is written as \"rgb\": the spectral channels are not written", e.loc));
+        }
+        other => {
+            return Err(BuildError::at(
+                &e.loc,
+                format!("film \"{other}\" is not supported (supported: \"rgb\"; \"gbuffer\" and \"spectral\" are written as \"rgb\")"),
+            ))
+        }
+    }
     let res = UVec2::new(
         p.get_int("xresolution", 1280)?.max(1) as u32,
         p.get_int("yresolution", 720)?.max(1) as u32,
