@@ -217,6 +217,32 @@ fn projection_image_orientation_follows_pbrt_v4() {
 }
 
 #[test]
+fn goniometric_map_centre_points_along_user_y() {
+    // pbrt-v4 swaps y and z: the equal-area map's centre texel (light-frame
+    // +z) lights the user's +y, its corners (−z) the user's −y. Identity
+    // transform; a map bright only in the centre 2×2 texels.
+    let map = image(8, 8, |u, v| {
+        if (u - 0.5).abs() < 0.2 && (v - 0.5).abs() < 0.2 {
+            [5.0f32]
+        } else {
+            [1.0]
+        }
+    });
+    let light = Light::Goniometric(goniometric_light(
+        &Transform::IDENTITY,
+        constant(1.0),
+        1.0,
+        None,
+        Some(&map),
+    ));
+    let up = intensity_towards(&light, Vec3::ZERO, Vec3::Y);
+    for w in [Vec3::Z, -Vec3::Z, Vec3::X, -Vec3::Y] {
+        let v = intensity_towards(&light, Vec3::ZERO, w);
+        assert!((up / v - 5.0).abs() < 1e-5, "{w}: {v} vs up {up}");
+    }
+}
+
+#[test]
 fn texel_solid_angles_match_closed_form_and_quadrature() {
     // The whole 90° square window: 4·asin(sin²45°) = 2π/3 [rectangular
     // pyramid]; a 1.5×1 window at 60°: 4·asin(sin α sin β).
