@@ -42,7 +42,7 @@ use super::{LightLeSample, LightLiSample, LightSampleContext};
 use crate::image::MapImage;
 use crate::interaction::Interaction;
 use crate::math::{Ray, Transform, Vec2, Vec3};
-use crate::sampling::{Distribution1D, PdfArea, PdfSolidAngle};
+use crate::sampling::{Distribution2D, PdfArea, PdfSolidAngle};
 use crate::spectrum::{
     ColorSpace, Rgb, SampledSpectrum, SampledWavelengths, SpectrumKind, N_SPECTRUM_SAMPLES,
 };
@@ -64,8 +64,9 @@ pub struct ProjectionLight {
     window: [f32; 4],
     /// Solid angle of each texel (row-major).
     omega: Arc<Vec<f32>>,
-    /// Texel choice ∝ avg(rgb)·Ω.
-    distribution: Arc<Distribution1D>,
+    /// Texel choice ∝ avg(rgb)·Ω (row, then column: no single CDF over
+    /// millions of texels in f32).
+    distribution: Arc<Distribution2D>,
 }
 
 /// Solid angle of [0, X]×[0, Y] on the plane z = 1 (signed by XY).
@@ -158,7 +159,7 @@ impl ProjectionLight {
             tan_half_fov: t,
             window,
             omega: Arc::new(omega),
-            distribution: Arc::new(Distribution1D::new(&weight)),
+            distribution: Arc::new(Distribution2D::new(&weight, w, h)),
         }
     }
 
@@ -226,20 +227,21 @@ impl ProjectionLight {
         })
     }
 
-    /// Texel by `u1.x` (∝ avg(rgb)·Ω), direction uniform in its solid angle by `u2`.
+    /// Texel by `u1` (∝ avg(rgb)·Ω), direction uniform in its solid angle by `u2`.
     pub fn sample_le(
         &self,
         u1: Vec2,
         u2: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLeSample> {
-        let (i, pmf, _) = self.distribution.sample_discrete(u1.x);
+        let ((ix, iy), pmf) = self.distribution.sample_discrete(u1);
+        let w = self.image.width;
+        let i = iy * w + ix;
         let omega = self.omega[i];
         if pmf == 0.0 || omega <= 0.0 {
             return None;
         }
-        let w = self.image.width;
-        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let (x, y) = (ix as f64, iy as f64);
         let [x0, y0, x1, y1] = self.window.map(|v| v as f64);
         let t = self.tan_half_fov as f64;
         let (dx, dy) = ((x1 - x0) / w as f64, (y1 - y0) / self.image.height as f64);
@@ -264,7 +266,7 @@ impl ProjectionLight {
                 let i = y * self.image.width + x;
                 let omega = self.omega[i];
                 if omega > 0.0 {
-                    self.distribution.discrete_pmf(i) / omega
+                    self.distribution.discrete_pmf(x, y) / omega
                 } else {
                     0.0
                 }
