@@ -183,8 +183,15 @@ mod tests {
         }
         for k in 0..9 {
             let want = f[k] as f64 / 12.0;
-            assert!((d.discrete_pmf(k % 3, k / 3) as f64 - want).abs() < 1e-6, "pmf {k}");
-            assert!((count[k] - want).abs() < 1e-3, "cell {k}: {} vs {want}", count[k]);
+            assert!(
+                (d.discrete_pmf(k % 3, k / 3) as f64 - want).abs() < 1e-6,
+                "pmf {k}"
+            );
+            assert!(
+                (count[k] - want).abs() < 1e-3,
+                "cell {k}: {} vs {want}",
+                count[k]
+            );
         }
     }
 
