@@ -23,7 +23,8 @@
 //! per subpath: with power-proportional light selection ([`LightSampler`])
 //! each subpath starts with exactly `β₀ = Φ_total`.
 //!
-//! Delta lights (point and spot: a delta in position; distant: a delta in
+//! Delta lights (point, spot, goniometric and projection: a delta in
+//! position; distant: a delta in
 //! direction) are flagged by [`Light::light_type`], never by huge densities:
 //! their delta component is reported with density 1 and must not enter MIS
 //! against techniques that cannot sample it.
@@ -36,9 +37,11 @@ mod create;
 mod diffuse_area;
 mod distant;
 mod emission;
+mod goniometric;
 mod image_infinite;
 mod infinite;
 mod point;
+mod projection;
 mod sampler;
 mod spot;
 
@@ -46,15 +49,17 @@ mod spot;
 mod tests;
 
 pub use create::{
-    diffuse_area_light, distant_light, image_infinite_light, point_light, spot_light,
-    uniform_infinite_light,
+    diffuse_area_light, distant_light, goniometric_light, image_infinite_light, point_light,
+    projection_light, spot_light, uniform_infinite_light,
 };
 pub use diffuse_area::DiffuseAreaLight;
 pub use distant::DistantLight;
 pub use emission::{spectrum_photometric, LightSpectrum};
+pub use goniometric::GoniometricLight;
 pub use image_infinite::ImageInfiniteLight;
 pub use infinite::UniformInfiniteLight;
 pub use point::PointLight;
+pub use projection::ProjectionLight;
 pub use sampler::LightSampler;
 pub use spot::SpotLight;
 
@@ -192,6 +197,10 @@ pub enum Light {
     Point(PointLight),
     /// Point light with a smooth-step cone falloff.
     Spot(SpotLight),
+    /// Point light with an equal-area intensity map.
+    Goniometric(GoniometricLight),
+    /// Point light projecting an RGB image through a frustum.
+    Projection(ProjectionLight),
     /// Parallel light from one direction.
     Distant(DistantLight),
     /// Lambertian emitter on a shape.
@@ -208,6 +217,8 @@ macro_rules! dispatch {
         match $self {
             Light::Point($l) => $body,
             Light::Spot($l) => $body,
+            Light::Goniometric($l) => $body,
+            Light::Projection($l) => $body,
             Light::Distant($l) => $body,
             Light::DiffuseArea($l) => $body,
             Light::UniformInfinite($l) => $body,
@@ -220,7 +231,9 @@ impl Light {
     /// The light's singularity class.
     pub fn light_type(&self) -> LightType {
         match self {
-            Light::Point(_) | Light::Spot(_) => LightType::DeltaPosition,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) | Light::Projection(_) => {
+                LightType::DeltaPosition
+            }
             Light::Distant(_) => LightType::DeltaDirection,
             Light::DiffuseArea(_) => LightType::Area,
             Light::UniformInfinite(_) | Light::ImageInfinite(_) => LightType::Infinite,
@@ -291,6 +304,8 @@ impl Light {
         match self {
             Light::Point(l) => l.pdf_le(ray),
             Light::Spot(l) => l.pdf_le(ray),
+            Light::Goniometric(l) => l.pdf_le(ray),
+            Light::Projection(l) => l.pdf_le(ray),
             Light::Distant(l) => l.pdf_le(ray),
             Light::UniformInfinite(l) => l.pdf_le(ray),
             Light::ImageInfinite(l) => l.pdf_le(ray),

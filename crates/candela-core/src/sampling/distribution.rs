@@ -124,6 +124,19 @@ impl Distribution2D {
         (Vec2::new(x, v), pdf_u * pdf_v)
     }
 
+    /// Chooses a cell with probability ∝ its value (row by `u.y`, column by
+    /// `u.x`); returns its (column, row) and probability.
+    pub fn sample_discrete(&self, u: Vec2) -> ((usize, usize), f32) {
+        let (iv, pmf_v, _) = self.marginal.sample_discrete(u.y);
+        let (iu, pmf_u, _) = self.conditional[iv].sample_discrete(u.x);
+        ((iu, iv), pmf_u * pmf_v)
+    }
+
+    /// Probability that [`sample_discrete`](Self::sample_discrete) returns cell (iu, iv).
+    pub fn discrete_pmf(&self, iu: usize, iv: usize) -> f32 {
+        self.marginal.discrete_pmf(iv) * self.conditional[iv].discrete_pmf(iu)
+    }
+
     /// Density at `p`.
     pub fn pdf(&self, p: Vec2) -> f32 {
         let nv = self.conditional.len();
@@ -149,6 +162,37 @@ mod tests {
         assert_eq!(d.discrete_pmf(1), 0.0);
         let (x, pdf, _) = d.sample_continuous(0.5);
         assert!(x >= 2.0 / 3.0 && (pdf - d.pdf(x)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn two_d_discrete_sampling_follows_weights() {
+        // 3×3 cells with a zero cell and a zero row; the frequencies of a
+        // 240×240 stratified grid (whose lines fall on every CDF step, all
+        // multiples of 1/24) match the pmfs to 1e-3, and the pmfs are f/Σf.
+        let f = [1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0, 2.0, 4.0];
+        let d = Distribution2D::new(&f, 3, 3);
+        let mut count = [0.0f64; 9];
+        let (nx, ny) = (240, 240);
+        for j in 0..ny {
+            for i in 0..nx {
+                let u = Vec2::new((i as f32 + 0.5) / nx as f32, (j as f32 + 0.5) / ny as f32);
+                let ((iu, iv), pmf) = d.sample_discrete(u);
+                assert_eq!(pmf, d.discrete_pmf(iu, iv));
+                count[iv * 3 + iu] += 1.0 / (nx * ny) as f64;
+            }
+        }
+        for k in 0..9 {
+            let want = f[k] as f64 / 12.0;
+            assert!(
+                (d.discrete_pmf(k % 3, k / 3) as f64 - want).abs() < 1e-6,
+                "pmf {k}"
+            );
+            assert!(
+                (count[k] - want).abs() < 1e-3,
+                "cell {k}: {} vs {want}",
+                count[k]
+            );
+        }
     }
 
     #[test]

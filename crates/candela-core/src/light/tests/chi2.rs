@@ -16,7 +16,7 @@ use super::*;
 use crate::math::{Frame, Ray, Transform, PI};
 
 /// Number of χ² tests in this file (for the Šidák correction).
-const N_TESTS: i32 = 6;
+const N_TESTS: i32 = 8;
 const N_SAMPLES: usize = 1_000_000;
 const N_THETA: usize = 48;
 const N_PHI: usize = 64;
@@ -272,4 +272,21 @@ fn chi2_spot_light_le() {
     let sample = |r: &mut Pcg32| light.sample_le(u2(r), u2(r), &lam).map(|s| s.ray.d);
     let pdf = |w: Vec3| light.pdf_le(&Ray::new(Vec3::ZERO, w)).1 .0 as f64;
     chi2_directions("spot le", dir, 0.8, sample, &pdf);
+}
+
+#[test]
+fn chi2_goniometric_and_projection_le() {
+    // Emitted directions against pdf_le: the goniometric map over the whole
+    // sphere, the 60° projector on the cap cos θ > 0.6 about its axis (the
+    // frustum's corners are at cos θ = 0.693; the rest cell must stay empty).
+    use super::punctual_maps::{gonio_light, projector, projector_axis};
+    let lam = lambda();
+    for (name, light, axis, cos_lo) in [
+        ("goniometric le", gonio_light(), Vec3::Z, -1.0),
+        ("projection le", projector(), projector_axis(), 0.6),
+    ] {
+        let sample = |r: &mut Pcg32| light.sample_le(u2(r), u2(r), &lam).map(|s| s.ray.d);
+        let pdf = |w: Vec3| light.pdf_le(&Ray::new(Vec3::ZERO, w)).1 .0 as f64;
+        chi2_directions(name, axis, cos_lo, sample, &pdf);
+    }
 }

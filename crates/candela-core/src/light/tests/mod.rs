@@ -10,6 +10,7 @@ mod fixtures;
 mod image_infinite;
 mod irradiance;
 mod power;
+mod punctual_maps;
 
 use super::*;
 use crate::math::Vec2;

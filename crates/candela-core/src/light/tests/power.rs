@@ -1,7 +1,10 @@
 //! T3: power bookkeeping — Φ closed forms, β₀ of emitted samples, light selection.
 
 use super::*;
+use crate::image::{MapImage, PixelFormat};
 use crate::math::{Ray, Transform, PI};
+use crate::spectrum::{ColorSpace, Rgb, SpectrumKind};
+use std::sync::Arc;
 
 fn point(i: f32, at: Vec3) -> Light {
     Light::Point(PointLight::new(Transform::translate(at), constant(i), 1.0))
@@ -59,8 +62,33 @@ fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
     inf.preprocess(&unit_scene());
     let pi = std::f64::consts::PI;
     let (ce, cs) = (30f64.to_radians().cos(), 25f64.to_radians().cos());
+    // Goniometric: Φ = 4π·I·mean(Y); projector of a white 6×4 slide at 60°:
+    // Φ = I·4·asin(sin α·sin β), tan α = 1.5·tan 30°, tan β = tan 30°
+    // (the solid angle of a rectangular pyramid).
+    let map = super::punctual_maps::gonio_map();
+    let mean_y = map.data.iter().map(|&v| v as f64).sum::<f64>() / map.data.len() as f64;
+    let gonio = Light::Goniometric(GoniometricLight::new(
+        Transform::translate(Vec3::new(0.0, 2.0, 0.0)),
+        constant(3.0),
+        1.0,
+        Arc::new(map),
+    ));
+    let srgb = ColorSpace::srgb();
+    let white = MapImage::new(6, 4, 3, vec![1.0; 72], PixelFormat::Float);
+    let proj = Light::Projection(ProjectionLight::new(
+        Transform::translate(Vec3::new(0.5, 0.0, 0.0)),
+        Arc::new(white),
+        srgb,
+        1.0,
+        60.0,
+    ));
+    let i_white = srgb.sample_rgb(Rgb::new(1.0, 1.0, 1.0), SpectrumKind::Illuminant, &lambda())[0];
+    let t = (30f64).to_radians().tan();
+    let (sa, sb) = ((1.5 * t).atan().sin(), t.atan().sin());
     vec![
         ("point", point(100.0, Vec3::ONE), 4.0 * pi * 100.0),
+        ("goniometric", gonio, 4.0 * pi * 3.0 * mean_y),
+        ("projection", proj, i_white as f64 * 4.0 * (sa * sb).asin()),
         (
             "spot",
             spot(),
@@ -198,11 +226,32 @@ fn power_selection_starts_every_subpath_with_total_phi() {
         let b = s.beta0(pmf)[0];
         assert!((b - 4.0 * PI * 100.0).abs() <= 1e-6 * b, "β₀ = {b}");
     }
+    // Each light alone, with exact emission sampling (β₀ = Φ per sample),
+    // including the projector, whose spectrum is the colour space's
+    // illuminant rather than a constant.
+    for (name, light, phi) in lights_with_phi() {
+        let ls = LightSampler::power(std::slice::from_ref(&light));
+        let mut r = Pcg32::new(3, 1);
+        for _ in 0..1000 {
+            let (_, pmf) = ls.sample(r.uniform_f32()).unwrap();
+            if let Some(s) = light.sample_le(u2(&mut r), u2(&mut r), &lam) {
+                let b = s.beta0(pmf)[0] as f64;
+                assert!((b - phi).abs() <= 1e-4 * phi, "{name}: β₀ {b} vs Φ {phi}");
+            }
+        }
+    }
     // Several lights: β₀ = Φ_total per sample (constant spectra, exact
     // emission sampling) and hence in expectation; uniform selection only
-    // in expectation (5σ).
-    let lights: Vec<Light> = lights_with_phi().into_iter().map(|(_, l, _)| l).collect();
-    let total: f64 = lights_with_phi().iter().map(|(_, _, p)| p).sum();
+    // in expectation (5σ). The selection weighs each light by ∫Φ(λ)dλ, so
+    // β₀ is the same at every wavelength only when all spectra share one
+    // shape: the projector (illuminant spectrum) is left out here.
+    let with_phi = || {
+        lights_with_phi()
+            .into_iter()
+            .filter(|(name, _, _)| *name != "projection")
+    };
+    let lights: Vec<Light> = with_phi().map(|(_, l, _)| l).collect();
+    let total: f64 = with_phi().map(|(_, _, p)| p).sum();
     for (kind, ls) in [
         ("power", LightSampler::power(&lights)),
         ("uniform", LightSampler::uniform(&lights)),

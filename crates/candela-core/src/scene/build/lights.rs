@@ -7,6 +7,14 @@
 //! `portal` is ignored with a warning: pbrt-v4's `PortalImageInfiniteLight`
 //! samples only directions through the portal and shows the sky only there,
 //! which renders the same wherever the portal is the scene's only opening.
+//!
+//! `"goniometric"` and `"projection"` follow their pbrt-v4 `Create`
+//! functions: `filename` (PNG or EXR) is required for a projector and
+//! optional for a goniometric light (isotropic without it, with a warning;
+//! pbrt-v4 only warns and then divides by the empty image's size), the
+//! goniometric map must be square, the projector's image RGB, and neither
+//! may hold infinite or NaN texels. A projector's `fov` must lie in
+//! (0°, 180°).
 
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
@@ -110,7 +118,9 @@ fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError>
             v3("to", Vec3::Z)?,
         )),
         "infinite" => infinite(d, &t, space, scale, warnings)?,
-        other => return Err(BuildError::at(&d.loc, format!("light \"{other}\" is not supported yet (supported: point, spot, distant, infinite)"))),
+        "goniometric" => goniometric(d, &t, illum("I")?, scale, warnings)?,
+        "projection" => projection(d, &t, scale, warnings)?,
+        other => return Err(BuildError::at(&d.loc, format!("light \"{other}\" is not supported (supported: point, spot, goniometric, projection, distant, infinite)"))),
     })
 }
 
@@ -157,8 +167,95 @@ fn infinite(
     )))
 }
 
-/// An equal-area environment map: a square, finite RGB image.
-fn env_map(
+/// pbrt-v4 `"goniometric"`: `I`, `scale`, `power` and an optional map.
+fn goniometric(
+    d: &LightDesc,
+    t: &Transform,
+    i: Spectrum,
+    scale: f32,
+    warnings: &mut Vec<String>,
+) -> Result<Light, BuildError> {
+    let p = &d.params;
+    let power = optional_positive(p.get_float("power", -1.0)?);
+    let image = match p.get_filename("filename")? {
+        Some(path) => {
+            let loc = p.param_loc("filename").unwrap_or(&d.loc);
+            let (im, _) = light_image(&path, loc, warnings)?;
+            if im.width != im.height {
+                return Err(BuildError::at(
+                    loc,
+                    format!(
+                        "{}: image resolution ({}, {}) is non-square; it is unlikely to be an equal-area map",
+                        path.display(),
+                        im.width,
+                        im.height
+                    ),
+                ));
+            }
+            Some(im)
+        }
+        None => {
+            warnings.push(format!(
+                "{}: no \"filename\" parameter provided for goniometric light; it emits isotropically",
+                d.loc
+            ));
+            None
+        }
+    };
+    Ok(Light::Goniometric(create::goniometric_light(
+        t,
+        i,
+        scale,
+        power,
+        image.as_ref(),
+    )))
+}
+
+/// pbrt-v4 `"projection"`: RGB `filename` (required), `fov`, `scale`, `power`.
+fn projection(
+    d: &LightDesc,
+    t: &Transform,
+    scale: f32,
+    warnings: &mut Vec<String>,
+) -> Result<Light, BuildError> {
+    let p = &d.params;
+    let power = optional_positive(p.get_float("power", -1.0)?);
+    let fov = p.get_float("fov", 90.0)?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(BuildError::at(
+            p.param_loc("fov").unwrap_or(&d.loc),
+            format!("\"fov\" of a \"projection\" light must lie in (0, 180) degrees, not {fov}"),
+        ));
+    }
+    let Some(path) = p.get_filename("filename")? else {
+        return Err(BuildError::at(
+            &d.loc,
+            "must provide \"filename\" to \"projection\" light source",
+        ));
+    };
+    let loc = p.param_loc("filename").unwrap_or(&d.loc);
+    let (im, color_space) = light_image(&path, loc, warnings)?;
+    if im.channels != 3 {
+        return Err(BuildError::at(
+            loc,
+            format!(
+                "{}: image provided to \"projection\" light must have R, G, and B channels",
+                path.display()
+            ),
+        ));
+    }
+    Ok(Light::Projection(create::projection_light(
+        t,
+        &im,
+        color_space,
+        scale,
+        power,
+        fov,
+    )))
+}
+
+/// An image read for a light: it exists, decodes, and every texel is finite.
+fn light_image(
     path: &Path,
     loc: &Loc,
     warnings: &mut Vec<String>,
@@ -175,7 +272,25 @@ fn env_map(
     if let Some(w) = file.warning {
         warnings.push(format!("{loc}: {w}"));
     }
-    let im = file.image;
+    if file.image.data.iter().any(|v| !v.is_finite()) {
+        return Err(BuildError::at(
+            loc,
+            format!("{name}: image has infinite or not-a-number pixel values and so is not suitable as a light"),
+        ));
+    }
+    // Fit the RGB table now rather than on the first lookup, mid-render.
+    file.color_space.rgb_table();
+    Ok((file.image, file.color_space))
+}
+
+/// An equal-area environment map: a square, finite RGB image.
+fn env_map(
+    path: &Path,
+    loc: &Loc,
+    warnings: &mut Vec<String>,
+) -> Result<(MapImage, &'static ColorSpace), BuildError> {
+    let name = path.display();
+    let (im, color_space) = light_image(path, loc, warnings)?;
     let fail = |msg: String| Err(BuildError::at(loc, format!("{name}: {msg}")));
     if im.channels != 3 {
         return fail("image provided to \"infinite\" light must have R, G, and B channels".into());
@@ -186,13 +301,5 @@ fn env_map(
             im.width, im.height
         ));
     }
-    if im.data.iter().any(|v| !v.is_finite()) {
-        return fail(
-            "image has infinite or not-a-number pixel values and so is not suitable as a light"
-                .into(),
-        );
-    }
-    // Fit the RGB table now rather than on the first lookup, mid-render.
-    file.color_space.rgb_table();
-    Ok((im, file.color_space))
+    Ok((im, color_space))
 }

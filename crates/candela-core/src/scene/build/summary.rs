@@ -87,6 +87,8 @@ fn light_kind(l: &Light) -> &'static str {
     match l {
         Light::Point(_) => "point",
         Light::Spot(_) => "spot",
+        Light::Goniometric(_) => "goniometric",
+        Light::Projection(_) => "projection",
         Light::Distant(_) => "distant",
         Light::DiffuseArea(_) => "diffuse area",
         Light::UniformInfinite(_) => "infinite (uniform)",

@@ -1,0 +1,142 @@
+//! Goniometric light: a point light whose intensity varies with direction as
+//! a measured goniophotometric diagram [pbrt-v4 `GoniometricLight`, §12.2.3].
+//!
+//! `I(ω) = scale·I_e(λ)·Y(ω)`, where `Y` is a single-channel square image in
+//! the equal-area octahedral parameterisation [Clarberg 2008]: ω, in the
+//! light's frame, maps to (u, v) = [`equal_area_sphere_to_square`]`(ω)` and
+//! the texel containing (u, v) gives `Y` (nearest lookup). pbrt-v4's
+//! `Create` turns an RGB image into `Y` by the plain average (R + G + B)/3,
+//! and composes the user's light transform with a swap of y and z, so the
+//! image centre (light-frame +z here) points along the user's +y.
+//!
+//! **Power.** Every texel covers 4π/N steradians, so
+//! Φ = ∫ I dω = 4π·scale·I_e·mean(Y) exactly [pbrt-v4 `Phi`].
+//!
+//! **Emission sampling.** A piecewise-constant 2D distribution over the
+//! texels weighted by `Y` samples (u, v) with density p(u, v); the map is
+//! equal-area, so p_dir = p/(4π) without a Jacobian [pbrt-v4 `SampleLe`].
+//! Then p_dir(ω) = Y(ω)/(4π·mean Y) is proportional to I(ω) and
+//! `β₀ = I/p_dir = Φ` for every sample.
+
+use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
+use crate::image::{MapImage, WrapMode};
+use crate::interaction::Interaction;
+use crate::math::{Ray, Transform, Vec2, Vec3, PI};
+use crate::sampling::{
+    equal_area_sphere_to_square, equal_area_square_to_sphere, Distribution2D, PdfArea,
+    PdfSolidAngle,
+};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use std::sync::Arc;
+
+/// A point light at the light-frame origin with an equal-area intensity map.
+#[derive(Clone, Debug)]
+pub struct GoniometricLight {
+    render_from_light: Transform,
+    light_from_render: Transform,
+    i: LightSpectrum,
+    scale: f32,
+    image: Arc<MapImage>,
+    distribution: Arc<Distribution2D>,
+    mean_y: f32,
+}
+
+impl GoniometricLight {
+    /// Light of intensity `scale·i·Y(ω)`, `Y` a square one-channel image of
+    /// non-negative values in the equal-area parameterisation of the light
+    /// frame (pbrt-v4's constructor; the y/z swap belongs to the caller).
+    pub fn new(
+        render_from_light: Transform,
+        i: LightSpectrum,
+        scale: f32,
+        image: Arc<MapImage>,
+    ) -> Self {
+        assert_eq!(image.width, image.height, "equal-area maps are square");
+        assert_eq!(image.channels, 1, "goniometric maps have one channel");
+        debug_assert!(image.data.iter().all(|v| *v >= 0.0 && v.is_finite()));
+        let distribution = Arc::new(Distribution2D::new(&image.data, image.width, image.height));
+        let sum: f64 = image.data.iter().map(|&v| v as f64).sum();
+        let mean_y = (sum / image.data.len() as f64) as f32;
+        Self {
+            light_from_render: render_from_light.inverse(),
+            render_from_light,
+            i,
+            scale,
+            image,
+            distribution,
+            mean_y,
+        }
+    }
+
+    /// Position in render space.
+    pub fn position(&self) -> Vec3 {
+        self.render_from_light.point(Vec3::ZERO)
+    }
+
+    /// Intensity towards light-frame unit direction `wl` [W/sr].
+    pub fn intensity(&self, wl: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let uv = equal_area_sphere_to_square(wl);
+        let y = self.image.nearest_rgb(uv, WrapMode::Clamp)[0];
+        self.i.sample(lambda) * (self.scale * y)
+    }
+
+    /// Incident radiance I(ω)/d² towards the light; density 1 (delta).
+    pub fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        _u: Vec2,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightLiSample> {
+        let p = self.position();
+        let d2 = p.distance_squared(ctx.p);
+        if d2 == 0.0 {
+            return None;
+        }
+        let wi = (p - ctx.p) / d2.sqrt();
+        let wl = self.light_from_render.vector(-wi).normalize();
+        let l = self.intensity(wl, lambda) / d2;
+        if l.is_black() {
+            return None;
+        }
+        Some(LightLiSample {
+            l,
+            wi,
+            pdf: PdfSolidAngle(1.0),
+            p_light: Interaction::at_point(p),
+        })
+    }
+
+    /// A direction drawn from the texel distribution (`u1`).
+    pub fn sample_le(
+        &self,
+        u1: Vec2,
+        _u2: Vec2,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let (uv, map_pdf) = self.distribution.sample(u1);
+        if map_pdf == 0.0 {
+            return None;
+        }
+        let wl = equal_area_square_to_sphere(uv);
+        let d = self.render_from_light.vector(wl).normalize();
+        Some(LightLeSample {
+            l: self.intensity(wl, lambda),
+            ray: Ray::new(self.position(), d),
+            intr: None,
+            pdf_pos: PdfArea(1.0),
+            pdf_dir: PdfSolidAngle(map_pdf / (4.0 * PI)),
+        })
+    }
+
+    /// Densities of [`sample_le`](Self::sample_le) for `ray`: (1 (delta), p(u, v)/(4π)).
+    pub fn pdf_le(&self, ray: &Ray) -> (PdfArea, PdfSolidAngle) {
+        let wl = self.light_from_render.vector(ray.d).normalize();
+        let map_pdf = self.distribution.pdf(equal_area_sphere_to_square(wl));
+        (PdfArea(1.0), PdfSolidAngle(map_pdf / (4.0 * PI)))
+    }
+
+    /// Φ = 4π·scale·I_e·mean(Y).
+    pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.i.sample(lambda) * (4.0 * PI * self.scale * self.mean_y)
+    }
+}
