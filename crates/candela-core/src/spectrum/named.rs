@@ -1,8 +1,9 @@
-//! Spectra that pbrt-v4 scenes name by string: CIE standard illuminants
-//! (normalised to luminance Y = 1 as pbrt-v4 does), metal optical constants
-//! and glass dispersion (Sellmeier equations with Schott's coefficients).
+//! Spectra that pbrt-v4 scenes name by string: CIE standard illuminants and
+//! ACES D60 (normalised to luminance Y = 1 as pbrt-v4 does), metal optical
+//! constants, glass dispersion (Sellmeier equations with Schott's
+//! coefficients) and the camera sensitivities `<sensor>_r/_g/_b`.
 
-use super::data::{cie, metals};
+use super::data::{cie, daylight, metals};
 use super::spectra::{inner_product, PiecewiseLinear, Spectrum};
 use super::{cie_xyz, CIE_Y_INTEGRAL};
 use std::sync::{Arc, OnceLock};
@@ -33,6 +34,19 @@ fn d50() -> Arc<PiecewiseLinear> {
             cie::D50_START,
             5.0,
             &cie::ILLUM_D50,
+        )))
+    })
+    .clone()
+}
+
+/// ACES D60, normalised (pbrt-v4 `illum-acesD60`, the ACES2065-1 white).
+pub fn aces_d60() -> Arc<PiecewiseLinear> {
+    static S: OnceLock<Arc<PiecewiseLinear>> = OnceLock::new();
+    S.get_or_init(|| {
+        Arc::new(normalized(PiecewiseLinear::from_even(
+            daylight::S_START,
+            5.0,
+            &daylight::ACES_D60,
         )))
     })
     .clone()
@@ -78,6 +92,7 @@ pub fn named_spectrum(name: &str) -> Option<Spectrum> {
         "stdillum-D65" => Spectrum::PiecewiseLinear(d65()),
         "stdillum-D50" => Spectrum::PiecewiseLinear(d50()),
         "stdillum-A" => Spectrum::PiecewiseLinear(illuminant_a()),
+        "illum-acesD60" => Spectrum::PiecewiseLinear(aces_d60()),
         "metal-Cu-eta" => table(&metals::CU_LAMBDA, &metals::CU_ETA),
         "metal-Cu-k" => table(&metals::CU_LAMBDA, &metals::CU_K),
         "metal-Ag-eta" => table(&metals::CU_LAMBDA, &metals::AG_ETA),
@@ -102,6 +117,6 @@ pub fn named_spectrum(name: &str) -> Option<Spectrum> {
             [2.000_295_47, 0.298_926_886, 1.806_918_43],
             [0.012_142_601_7, 0.053_873_623_6, 156.530_829],
         ),
-        _ => return None,
+        _ => return super::sensor::named_sensor_curve(name).map(Spectrum::PiecewiseLinear),
     })
 }
