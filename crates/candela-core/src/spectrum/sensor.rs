@@ -298,7 +298,11 @@ pub(super) fn training_pairs(
 }
 
 /// M = argmin Σ‖M c_i − t_i‖², i.e. Mᵀ = (CᵀC)⁻¹ CᵀT [pbrt-v4 `LinearLeastSquares`].
-fn fit_xyz_from_sensor_rgb(curves: &CameraCurves, cs: &ColorSpace, illuminant: &Spectrum) -> Mat3 {
+pub(super) fn fit_xyz_from_sensor_rgb(
+    curves: &CameraCurves,
+    cs: &ColorSpace,
+    illuminant: &Spectrum,
+) -> Mat3 {
     let pairs = training_pairs(curves, cs, illuminant);
     let outer = |a: DVec3, b: DVec3| DMat3::from_cols(a * b.x, a * b.y, a * b.z);
     let (mut ctc, mut ctt) = (DMat3::ZERO, DMat3::ZERO);
