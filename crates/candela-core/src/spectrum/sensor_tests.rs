@@ -321,25 +321,9 @@ fn aces_round_trips_and_has_the_d60_white() {
     assert!((w.y - 1.0).abs() < 1e-5 && (w.x / w.element_sum() - x).abs() < 1e-5);
 }
 
-/// RGB (under the colour space's illuminant) of a fitted reflectance, and its range.
+/// RGB (under the colour space's illuminant) of the exactly fitted reflectance, and its range.
 fn fitted_rgb(cs: &ColorSpace, rgb: Rgb) -> (Vec3, f32, f32) {
-    let p = fit_sigmoid(cs, rgb);
-    let w = spectral_weights(cs);
-    let mut out = [0.0f64; 3];
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for (i, wi) in w.iter().enumerate() {
-        let s = p.eval(LAMBDA_MIN + i as f32);
-        lo = lo.min(s);
-        hi = hi.max(s);
-        for k in 0..3 {
-            out[k] += wi[k] * s as f64;
-        }
-    }
-    (
-        Vec3::new(out[0] as f32, out[1] as f32, out[2] as f32),
-        lo,
-        hi,
-    )
+    rgb_of_poly(cs, fit_sigmoid(cs, rgb))
 }
 
 #[test]
@@ -392,4 +376,59 @@ fn aces_rgb2spec_fits_in_gamut_colours_and_stays_bounded_outside() {
         eprintln!("ACES {a:?} → {got} (spectrum in [{lo:.3}, {hi:.3}])");
         assert!(got.is_finite() && lo >= 0.0 && hi <= 1.0);
     }
+}
+
+#[test]
+fn aces_rgb_table_round_trips_in_gamut_colours() {
+    // Image textures and maps in ACES go through the tabulated fit. For
+    // reflectance colours (random sRGB albedos, adapted to D60) its round trip
+    // must match the sRGB table's (1.2e-3 measured; bound 2e-3); AP0 corners
+    // that no reflectance reaches must still give finite, bounded spectra.
+    let aces = ColorSpace::aces2065_1();
+    let srgb = ColorSpace::srgb();
+    let t0 = std::time::Instant::now();
+    let table = aces.rgb_table();
+    eprintln!("ACES table built in {:.2?}", t0.elapsed());
+    let adapt =
+        aces.rgb_from_xyz * white_balance(srgb.white_xy(), aces.white_xy()) * srgb.xyz_from_rgb;
+    let mut r = crate::sampling::Pcg32::new(5, 9);
+    let mut worst = 0.0f32;
+    for _ in 0..300 {
+        let a = adapt * Vec3::new(r.uniform_f32(), r.uniform_f32(), r.uniform_f32());
+        let p = table.coeffs(Rgb::new(a.x, a.y, a.z));
+        let (got, _, _) = rgb_of_poly(aces, p);
+        worst = worst.max((got - a).abs().max_element());
+    }
+    eprintln!("ACES table: worst |Δrgb| {worst:.2e}");
+    assert!(worst < 2e-3, "{worst}");
+    for c in [
+        [0.0, 0.0, 1.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 1.0],
+        [0.9, 0.0, 0.05],
+    ] {
+        let p = table.coeffs(Rgb::new(c[0], c[1], c[2]));
+        let (got, lo, hi) = rgb_of_poly(aces, p);
+        assert!(got.is_finite() && lo >= 0.0 && hi <= 1.0, "{c:?}: {got}");
+    }
+}
+
+/// RGB of the sigmoid spectrum `p` under the colour space's illuminant, and its range.
+fn rgb_of_poly(cs: &ColorSpace, p: RgbSigmoidPolynomial) -> (Vec3, f32, f32) {
+    let w = spectral_weights(cs);
+    let mut out = [0.0f64; 3];
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for (i, wi) in w.iter().enumerate() {
+        let s = p.eval(LAMBDA_MIN + i as f32);
+        lo = lo.min(s);
+        hi = hi.max(s);
+        for k in 0..3 {
+            out[k] += wi[k] * s as f64;
+        }
+    }
+    (
+        Vec3::new(out[0] as f32, out[1] as f32, out[2] as f32),
+        lo,
+        hi,
+    )
 }
