@@ -43,7 +43,7 @@ fn camera_data_has_every_sensor_with_35_samples_from_380_to_720_nm() {
     }
     // pbrt-v4 also carries the Canon 5D Mark II curves as a separate 10-digit
     // table (`Canon_eos5dmkii_R`); the transcribed r̄ must agree with it.
-    let r_5d2 = [
+    let r_5d2: [f64; 35] = [
         0.0008013842,
         0.0006220757,
         0.001637148,
@@ -83,7 +83,7 @@ fn camera_data_has_every_sensor_with_35_samples_from_380_to_720_nm() {
     let cam = cameras().iter().find(|c| c.name == "canon_eos_5d_mkii");
     let cam = cam.expect("canon_eos_5d_mkii is shipped");
     for (i, v) in r_5d2.iter().enumerate() {
-        let got = cam.rgb[0].eval(380.0 + 10.0 * i as f32);
+        let got = cam.rgb[0].eval(380.0 + 10.0 * i as f32) as f64;
         assert!((got - v).abs() <= 1e-6 * v, "{i}: {got} vs {v}");
     }
     // Sums of a few curves as read from pbrt-v4 (f64 sums of the file's values).
