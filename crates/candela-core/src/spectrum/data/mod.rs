@@ -2,5 +2,7 @@
 
 pub mod cie;
 pub mod daylight;
+pub mod dielectrics;
+pub mod fluorescent;
 pub mod metals;
 pub mod swatches;
