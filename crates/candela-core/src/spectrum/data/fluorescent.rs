@@ -2,6 +2,9 @@
 //! in pbrt-v4 (`src/pbrt/util/spectrum.cpp`, `CIE_Illum_F1` … `CIE_Illum_F12`):
 //! relative spectral power, 380..=780 nm at 5 nm (unnormalised).
 
+// Measured values: some happen to be close to π or τ, which clippy flags.
+#![allow(clippy::approx_constant)]
+
 /// First wavelength [nm]; samples step by 5 nm.
 pub const F_START: f32 = 380.0;
 
