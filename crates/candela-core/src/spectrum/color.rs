@@ -1,4 +1,4 @@
-//! Colour: RGB and XYZ triples, RGB colour spaces, and the pixel sensor.
+//! Colour: RGB and XYZ triples, RGB colour spaces, and white balancing.
 
 use super::rgb2spec::{fit_sigmoid, RgbSigmoidPolynomial};
 use super::rgb2spec_table::{RgbToSpectrumTable, TABLE_RES};
@@ -181,12 +181,28 @@ impl ColorSpace {
             )
         })
     }
-    /// Looks up a colour space by pbrt-v4 name (`aces2065-1` is not available yet).
+    /// ACES2065-1: the AP0 primaries, which enclose the spectral locus (the
+    /// green and blue ones are not physical colours), with the ACES D60 white
+    /// [pbrt-v4 `RGBColorSpace::ACES2065_1`; SMPTE ST 2065-1].
+    pub fn aces2065_1() -> &'static ColorSpace {
+        static CS: OnceLock<ColorSpace> = OnceLock::new();
+        CS.get_or_init(|| {
+            ColorSpace::new(
+                "aces2065-1",
+                (0.7347, 0.2653),
+                (0.0, 1.0),
+                (0.0001, -0.077),
+                named::aces_d60(),
+            )
+        })
+    }
+    /// Looks up a colour space by pbrt-v4 name.
     pub fn by_name(name: &str) -> Option<&'static ColorSpace> {
         match name {
             "srgb" => Some(Self::srgb()),
             "rec2020" => Some(Self::rec2020()),
             "dci-p3" => Some(Self::dci_p3()),
+            "aces2065-1" => Some(Self::aces2065_1()),
             _ => None,
         }
     }
@@ -261,27 +277,30 @@ impl ColorSpace {
     }
 }
 
-/// The camera sensor of pbrt-v4's `rgb` film. Only `cie1931` so far: the
-/// sensor's response is XYZ itself, scaled by the imaging ratio
-/// (exposure time · ISO / 100).
-#[derive(Clone, Debug)]
-pub struct PixelSensor {
-    imaging_ratio: f32,
-}
+/// Bradford matrices of pbrt-v4 (`src/pbrt/util/color.h`), row-major:
+/// LMS cone responses from XYZ and back.
+const LMS_FROM_XYZ: [f32; 9] = [
+    0.8951, 0.2664, -0.1614, -0.7502, 1.7135, 0.0367, 0.0389, -0.0685, 1.0296,
+];
+const XYZ_FROM_LMS: [f32; 9] = [
+    0.986993,
+    -0.147054,
+    0.159963,
+    0.432305,
+    0.51836,
+    0.0492912,
+    -0.00852866,
+    0.0400428,
+    0.968487,
+];
 
-impl PixelSensor {
-    /// The CIE 1931 sensor.
-    pub fn cie1931(imaging_ratio: f32) -> Self {
-        Self { imaging_ratio }
-    }
-    /// Sensor RGB of sampled radiance: imaging ratio × (∫ x̄ L, ∫ ȳ L, ∫ z̄ L)
-    /// estimated from the samples. No 1/∫ȳ here: pbrt-v4 folds that into the
-    /// lights' 1/`SpectrumToPhotometric` scale, so a 1-nit white light reads 1.
-    pub fn to_sensor_rgb(&self, l: SampledSpectrum, lambda: &SampledWavelengths) -> [f32; 3] {
-        sensor_response(l, lambda).map(|v| v * self.imaging_ratio)
-    }
-    /// XYZ from sensor RGB (identity for `cie1931`).
-    pub fn xyz_from_sensor_rgb(&self) -> Mat3 {
-        Mat3::IDENTITY
-    }
+/// The von Kries white balance in Bradford LMS space that maps the white of
+/// chromaticity `src` to `dst` (both at Y = 1) [pbrt-v4 `WhiteBalance`]:
+/// XYZ_from_LMS · diag(LMS(dst)/LMS(src)) · LMS_from_XYZ.
+pub fn white_balance(src: (f32, f32), dst: (f32, f32)) -> Mat3 {
+    let lms_from_xyz = Mat3::from_cols_array(&LMS_FROM_XYZ).transpose();
+    let xyz_from_lms = Mat3::from_cols_array(&XYZ_FROM_LMS).transpose();
+    let s = lms_from_xyz * Xyz::from_xy(src.0, src.1, 1.0).vec();
+    let d = lms_from_xyz * Xyz::from_xy(dst.0, dst.1, 1.0).vec();
+    xyz_from_lms * Mat3::from_diagonal(d / s) * lms_from_xyz
 }

@@ -6,21 +6,26 @@
 //! illuminants), closed forms (Planck blackbody, Sellmeier glass) and RGB
 //! values lifted by the sigmoid-polynomial model of Jakob & Hanika 2019, as
 //! pbrt-v4 does (albedo, unbounded and illuminant kinds). The film turns
-//! sampled radiance into XYZ through the CIE 1931 2° observer.
+//! sampled radiance into sensor RGB: XYZ through the CIE 1931 2° observer,
+//! or a measured camera's responses with a fitted XYZ matrix (`sensor`).
 
 mod color;
 mod data;
+mod daylight;
 mod named;
 mod rgb2spec;
 mod rgb2spec_table;
 mod sampled;
+mod sensor;
 mod spectra;
 
-pub use color::{ColorSpace, PixelSensor, Rgb, Xyz};
+pub use color::{white_balance, ColorSpace, Rgb, Xyz};
+pub use daylight::{daylight, daylight_cct, daylight_xy};
 pub use named::named_spectrum;
 pub use rgb2spec::RgbSigmoidPolynomial;
 pub use rgb2spec_table::{RgbToSpectrumTable, TABLE_RES};
 pub use sampled::*;
+pub use sensor::{cameras, sensor_names, CameraCurves, PixelSensor, UnknownSensor};
 pub use spectra::{
     inner_product, planck, spectrum_to_photometric, spectrum_to_xyz, PiecewiseLinear, Spectrum,
     SpectrumKind,
@@ -47,5 +52,7 @@ pub fn cie_xyz(lambda: f32) -> [f32; 3] {
     ]
 }
 
+#[cfg(test)]
+mod sensor_tests;
 #[cfg(test)]
 mod tests;

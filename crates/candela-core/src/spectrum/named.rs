@@ -1,8 +1,11 @@
-//! Spectra that pbrt-v4 scenes name by string: CIE standard illuminants
-//! (normalised to luminance Y = 1 as pbrt-v4 does), metal optical constants
-//! and glass dispersion (Sellmeier equations with Schott's coefficients).
+//! Spectra that pbrt-v4 scenes name by string: CIE standard illuminants A,
+//! D50, D65, F1–F12 and ACES D60 (normalised to luminance Y = 1 as pbrt-v4
+//! does), metal optical constants, glass dispersion (Sellmeier equations with
+//! Schott's coefficients for BK7, BAF10, FK51A, LASF9; pbrt-v4's tables for
+//! SF5, SF10, SF11) and the camera sensitivities `<sensor>_r/_g/_b` — every
+//! name in pbrt-v4's list.
 
-use super::data::{cie, metals};
+use super::data::{cie, daylight, dielectrics, fluorescent, metals};
 use super::spectra::{inner_product, PiecewiseLinear, Spectrum};
 use super::{cie_xyz, CIE_Y_INTEGRAL};
 use std::sync::{Arc, OnceLock};
@@ -36,6 +39,38 @@ fn d50() -> Arc<PiecewiseLinear> {
         )))
     })
     .clone()
+}
+
+/// ACES D60, normalised (pbrt-v4 `illum-acesD60`, the ACES2065-1 white).
+pub fn aces_d60() -> Arc<PiecewiseLinear> {
+    static S: OnceLock<Arc<PiecewiseLinear>> = OnceLock::new();
+    S.get_or_init(|| {
+        Arc::new(normalized(PiecewiseLinear::from_even(
+            daylight::S_START,
+            5.0,
+            &daylight::ACES_D60,
+        )))
+    })
+    .clone()
+}
+
+/// CIE fluorescent illuminant F`n` (1–12), normalised.
+fn fluorescent(n: usize) -> Option<Spectrum> {
+    static S: OnceLock<Vec<Arc<PiecewiseLinear>>> = OnceLock::new();
+    let all = S.get_or_init(|| {
+        fluorescent::ILLUM_F
+            .iter()
+            .map(|f| {
+                Arc::new(normalized(PiecewiseLinear::from_even(
+                    fluorescent::F_START,
+                    5.0,
+                    f,
+                )))
+            })
+            .collect()
+    });
+    let f = all.get(n.checked_sub(1)?)?;
+    Some(Spectrum::PiecewiseLinear(f.clone()))
 }
 
 /// CIE illuminant A by its defining formula (CIE 15: Planck with c₂ = 1.435·10⁷ nm·K, T = 2848 K).
@@ -78,6 +113,14 @@ pub fn named_spectrum(name: &str) -> Option<Spectrum> {
         "stdillum-D65" => Spectrum::PiecewiseLinear(d65()),
         "stdillum-D50" => Spectrum::PiecewiseLinear(d50()),
         "stdillum-A" => Spectrum::PiecewiseLinear(illuminant_a()),
+        "illum-acesD60" => Spectrum::PiecewiseLinear(aces_d60()),
+        "metal-MgO-eta" => Spectrum::piecewise_linear(&dielectrics::MGO_ETA),
+        "metal-MgO-k" => Spectrum::piecewise_linear(&dielectrics::MGO_K),
+        "metal-TiO2-eta" => Spectrum::piecewise_linear(&dielectrics::TIO2_ETA),
+        "metal-TiO2-k" => Spectrum::piecewise_linear(&dielectrics::TIO2_K),
+        "glass-F5" => Spectrum::piecewise_linear(&dielectrics::GLASS_SF5),
+        "glass-F10" => Spectrum::piecewise_linear(&dielectrics::GLASS_SF10),
+        "glass-F11" => Spectrum::piecewise_linear(&dielectrics::GLASS_SF11),
         "metal-Cu-eta" => table(&metals::CU_LAMBDA, &metals::CU_ETA),
         "metal-Cu-k" => table(&metals::CU_LAMBDA, &metals::CU_K),
         "metal-Ag-eta" => table(&metals::CU_LAMBDA, &metals::AG_ETA),
@@ -102,19 +145,11 @@ pub fn named_spectrum(name: &str) -> Option<Spectrum> {
             [2.000_295_47, 0.298_926_886, 1.806_918_43],
             [0.012_142_601_7, 0.053_873_623_6, 156.530_829],
         ),
-        // pbrt-v4 names Schott's dense flints SF5, SF10 and SF11 "glass-F5/F10/F11".
-        "glass-F5" => sellmeier(
-            [1.524_818_89, 0.187_085_527, 1.427_290_15],
-            [0.011_254_756, 0.058_899_539_2, 129.141_675],
-        ),
-        "glass-F10" => sellmeier(
-            [1.621_539_02, 0.256_287_842, 1.644_475_52],
-            [0.012_224_145_7, 0.059_573_677_5, 147.468_793],
-        ),
-        "glass-F11" => sellmeier(
-            [1.737_596_95, 0.313_747_346, 1.898_781_01],
-            [0.013_188_707, 0.062_306_814_2, 155.236_29],
-        ),
-        _ => return None,
+        _ => {
+            if let Some(n) = name.strip_prefix("stdillum-F") {
+                return n.parse().ok().and_then(fluorescent);
+            }
+            return super::sensor::named_sensor_curve(name).map(Spectrum::PiecewiseLinear);
+        }
     })
 }

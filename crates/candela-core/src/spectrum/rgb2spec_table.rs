@@ -177,7 +177,7 @@ fn fit_column(l: usize, x: f64, y: f64, z_nodes: &[f64], w: &[(f64, [f64; 3])]) 
             }
             None => out[prev],
         };
-        out[k] = gauss_newton(guess, node_rgb(l, x, y, z_nodes[k]), w);
+        out[k] = gauss_newton(bounded(guess), node_rgb(l, x, y, z_nodes[k]), w);
     };
     fit(start, start, None, &mut out);
     for k in start + 1..res {
@@ -250,6 +250,28 @@ fn step(jac: &[[f64; 3]; 3], r: &[f64; 3], damp: f64) -> Option<glam::DVec3> {
     (det.is_finite() && det.abs() > 1e-300).then(|| a.inverse() * g)
 }
 
+/// Largest |coefficient| (normalised λ) a fit may reach. Nodes outside the
+/// reflectance gamut (most of ACES2065-1's AP0 triangle, whose green and blue
+/// primaries are not physical colours) have their optimum at infinity: the
+/// fit keeps sharpening a step spectrum, and extrapolated warm starts along
+/// a column compound that to overflow (10⁴⁷ measured, NaN once stored in
+/// f32). Scaling c by a positive factor keeps the polynomial's roots, so
+/// capping ‖c‖∞ only stops the sharpening: beyond 10⁶ the step is within
+/// 10⁻⁶ nm of a jump. The sRGB table peaks at 4.2·10⁴ and is unaffected.
+const MAX_COEFF: f64 = 1e6;
+
+/// `c` scaled down to ‖c‖∞ ≤ [`MAX_COEFF`] (non-finite → the flat ½ spectrum).
+fn bounded(c: [f64; 3]) -> [f64; 3] {
+    let m = c.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if !m.is_finite() {
+        [0.0; 3]
+    } else if m > MAX_COEFF {
+        c.map(|v| v * (MAX_COEFF / m))
+    } else {
+        c
+    }
+}
+
 /// Iteration cap per node (warm starts converge in a handful).
 const MAX_ITERATIONS: usize = 30;
 
@@ -266,7 +288,7 @@ fn gauss_newton(mut c: [f64; 3], target: [f64; 3], w: &[(f64, [f64; 3])]) -> [f6
             break;
         }
         let Some(d) = step(&jac, &r, damp) else { break };
-        let cn = [c[0] + d.x, c[1] + d.y, c[2] + d.z];
+        let cn = bounded([c[0] + d.x, c[1] + d.y, c[2] + d.z]);
         let (rn, jn) = residual(cn, target, w);
         if norm2(&rn) < norm2(&r) {
             // Stagnation: out-of-gamut nodes only creep towards the boundary.

@@ -65,6 +65,10 @@ impl PiecewiseLinear {
         self.values.iter_mut().for_each(|v| *v *= s);
         self
     }
+    /// The (λ, value) samples.
+    pub fn samples(&self) -> impl Iterator<Item = (f32, f32)> + '_ {
+        self.lambda.iter().copied().zip(self.values.iter().copied())
+    }
     /// Largest value.
     pub fn max_value(&self) -> f32 {
         self.values.iter().copied().fold(0.0, f32::max)

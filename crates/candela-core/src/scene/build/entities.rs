@@ -68,23 +68,25 @@ pub fn film(
     let iso = p.get_float("iso", 100.0)?;
     let exposure_time = camera_exposure(desc)?;
     let sensor_name = p.get_string("sensor", "cie1931")?;
-    if sensor_name != "cie1931" {
+    let white_balance = p.get_float("whitebalance", 0.0)?;
+    if !(white_balance >= 0.0 && white_balance.is_finite()) {
         return Err(BuildError::at(
             &e.loc,
-            format!("sensor \"{sensor_name}\" is not supported yet (supported: \"cie1931\")"),
+            format!("\"whitebalance\" must be a temperature in K (0: none), found {white_balance}"),
         ));
     }
-    let white_balance = p.get_float("whitebalance", 0.0)?;
-    if white_balance != 0.0 {
+    if !(iso >= 0.0 && iso.is_finite()) {
         return Err(BuildError::at(
             &e.loc,
-            "\"whitebalance\" is not supported yet",
+            format!("\"iso\" must be non-negative, found {iso}"),
         ));
     }
     let cs = ColorSpace::by_name(&e.color_space).ok_or_else(|| {
         BuildError::at(&e.loc, format!("unknown color space \"{}\"", e.color_space))
     })?;
-    let sensor = PixelSensor::cie1931(exposure_time * iso / 100.0);
+    let sensor =
+        PixelSensor::from_name(&sensor_name, cs, white_balance, exposure_time * iso / 100.0)
+            .map_err(|err| BuildError::at(&e.loc, err.to_string()))?;
     let output_from_sensor = cs.rgb_from_xyz * sensor.xyz_from_sensor_rgb();
     let filter = filter(desc)?;
     let settings = FilmSettings {
