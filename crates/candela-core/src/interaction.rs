@@ -92,6 +92,65 @@ pub struct SurfaceInteraction {
     pub material: Option<MaterialId>,
     /// Area light attached to the hit primitive.
     pub area_light: Option<LightId>,
+    /// Screen-space derivatives of p and (u, v); zero until the scene
+    /// estimates the pixel footprint ([`crate::camera::PixelFootprint`]).
+    pub diff: Differentials,
+}
+
+/// Screen-space derivatives at a hit: how p and (u, v) change from one
+/// pixel to the next [pbrt-v4 `SurfaceInteraction::dpdx` … `dvdy`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Differentials {
+    /// ∂p/∂x.
+    pub dpdx: Vec3,
+    /// ∂p/∂y.
+    pub dpdy: Vec3,
+    /// ∂u/∂x.
+    pub dudx: f32,
+    /// ∂u/∂y.
+    pub dudy: f32,
+    /// ∂v/∂x.
+    pub dvdx: f32,
+    /// ∂v/∂y.
+    pub dvdy: f32,
+}
+
+impl Differentials {
+    /// (u, v) derivatives from ∂p/∂x and ∂p/∂y by least squares
+    /// [pbrt-v4 `ComputeDifferentials`, book §10.1.1]: ∂p/∂x ≈ ∂p/∂u ∂u/∂x +
+    /// ∂p/∂v ∂v/∂x is overdetermined (three equations, two unknowns), so
+    /// solve the normal equations AᵀA (∂u/∂x, ∂v/∂x)ᵀ = Aᵀ ∂p/∂x with
+    /// A = (∂p/∂u ∂p/∂v), and likewise for y. Non-finite results (a
+    /// degenerate parameterisation) become 0 and the rest is clamped to ±1e8.
+    pub fn from_dp(dpdx: Vec3, dpdy: Vec3, dpdu: Vec3, dpdv: Vec3) -> Self {
+        let (a00, a01, a11) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
+        let inv_det = 1.0 / (a00 * a11 - a01 * a01);
+        let inv_det = if inv_det.is_finite() { inv_det } else { 0.0 };
+        let solve = |b: Vec3| {
+            let (b0, b1) = (dpdu.dot(b), dpdv.dot(b));
+            let tidy = |x: f32| {
+                if x.is_finite() {
+                    x.clamp(-1e8, 1e8)
+                } else {
+                    0.0
+                }
+            };
+            (
+                tidy((a11 * b0 - a01 * b1) * inv_det),
+                tidy((a00 * b1 - a01 * b0) * inv_det),
+            )
+        };
+        let (dudx, dvdx) = solve(dpdx);
+        let (dudy, dvdy) = solve(dpdy);
+        Self {
+            dpdx,
+            dpdy,
+            dudx,
+            dudy,
+            dvdx,
+            dvdy,
+        }
+    }
 }
 
 impl SurfaceInteraction {
@@ -133,6 +192,7 @@ impl SurfaceInteraction {
             face_index: 0,
             material: None,
             area_light: None,
+            diff: Differentials::default(),
         }
     }
 
@@ -196,5 +256,32 @@ impl SurfaceInteraction {
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
         self.it.spawn_ray(d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A skewed parameterisation of the plane z = 0: ∂p/∂u = (2, 0, 0),
+    /// ∂p/∂v = (1, 3, 0). Screen steps built as ∂p/∂u·a + ∂p/∂v·b (plus an
+    /// out-of-plane part for y, which least squares projects away) must give
+    /// back (a, b) to rounding.
+    #[test]
+    fn uv_derivatives_solve_the_least_squares_system() {
+        let (dpdu, dpdv) = (Vec3::new(2.0, 0.0, 0.0), Vec3::new(1.0, 3.0, 0.0));
+        let dpdx = dpdu * 0.1 + dpdv * 0.2;
+        let dpdy = dpdu * -0.05 + dpdv * 0.4 + Vec3::new(0.0, 0.0, 5.0);
+        let d = Differentials::from_dp(dpdx, dpdy, dpdu, dpdv);
+        for (got, want) in [(d.dudx, 0.1), (d.dvdx, 0.2), (d.dudy, -0.05), (d.dvdy, 0.4)] {
+            assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+        }
+        assert_eq!((d.dpdx, d.dpdy), (dpdx, dpdy));
+        // A degenerate parameterisation gives zeros, not NaN.
+        let z = Differentials::from_dp(dpdx, dpdy, Vec3::ZERO, dpdv);
+        assert_eq!((z.dudx, z.dvdx, z.dudy, z.dvdy), (0.0, 0.0, 0.0, 0.0));
+        // Nearly parallel ∂p/∂u, ∂p/∂v: huge but finite values are clamped.
+        let h = Differentials::from_dp(Vec3::Y, Vec3::Y, Vec3::X, Vec3::new(1.0, 1e-9, 0.0));
+        assert!(h.dudx.abs() <= 1e8 && h.dvdx.abs() <= 1e8, "{h:?}");
     }
 }

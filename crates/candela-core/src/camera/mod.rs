@@ -25,12 +25,14 @@
 //!
 //! Importance is a scalar: the camera response does not depend on wavelength.
 
+mod footprint;
 mod orthographic;
 mod perspective;
 mod spherical;
 #[cfg(test)]
 mod tests;
 
+pub use footprint::PixelFootprint;
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
 pub use spherical::{SphericalCamera, SphericalMapping};

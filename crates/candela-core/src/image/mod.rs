@@ -4,11 +4,13 @@
 
 mod compare;
 mod map;
+mod pyramid;
 mod read;
 mod resize;
 
 pub use compare::{compare, Comparison};
 pub use map::{MapImage, PixelFormat, WrapMode};
+pub use pyramid::MipPyramid;
 pub use read::{read_map, ColorEncoding, MapFile};
 pub use resize::resize_to_power_of_two;
 

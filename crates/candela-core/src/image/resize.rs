@@ -85,7 +85,7 @@ pub fn resize_to_power_of_two(im: &MapImage, wrap: WrapMode) -> MapImage {
 }
 
 /// `v` after a round trip through the storage format.
-fn quantise(v: f32, format: PixelFormat) -> f32 {
+pub(super) fn quantise(v: f32, format: PixelFormat) -> f32 {
     match format {
         PixelFormat::U8(enc) => enc.to_linear(enc.to_u8(v) as f32 / 255.0),
         PixelFormat::Half => f16::from_f32(v).to_f32(),

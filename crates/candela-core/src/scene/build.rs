@@ -18,7 +18,7 @@ mod textures;
 
 pub use summary::{summarize, Counts, SceneSummary};
 
-use crate::camera::Camera;
+use crate::camera::{Camera, PixelFootprint};
 use crate::film::RgbFilm;
 use crate::integrator::Integrator;
 use crate::sampler::Sampler;
@@ -132,7 +132,12 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .collect();
     lights.extend(lights::lights(desc, &mut warnings)?);
     let shutter = entities::shutter(desc)?;
-    let scene = Scene::with_motion(prims, movers, shutter, materials, lights, power_sampling);
+    let mut scene = Scene::with_motion(prims, movers, shutter, materials, lights, power_sampling);
+    scene.set_footprint(Some(PixelFootprint::new(
+        &camera,
+        film.resolution(),
+        sampler.samples_per_pixel(),
+    )));
     if let Some(w) = photon_radius_warning(desc, &integrator_name, &scene)? {
         warnings.push(w);
     }

@@ -10,6 +10,7 @@ pub use primitive::Primitive;
 
 use crate::accel::Bvh;
 use crate::bsdf::Bsdf;
+use crate::camera::PixelFootprint;
 use crate::interaction::{Interaction, LightId, SurfaceInteraction};
 use crate::light::{Light, LightSampler};
 use crate::material::{mix_choice, Material};
@@ -32,6 +33,9 @@ pub struct Scene {
     infinite_lights: Vec<LightId>,
     light_sampler: LightSampler,
     bounds: Bounds3,
+    /// The camera's pixel footprint, for texture filtering (none: zero
+    /// differentials).
+    footprint: Option<PixelFootprint>,
 }
 
 impl Scene {
@@ -89,7 +93,18 @@ impl Scene {
             infinite_lights,
             light_sampler,
             bounds,
+            footprint: None,
         }
+    }
+
+    /// Sets the camera footprint that gives hits their screen-space
+    /// differentials in [`Scene::bsdf`].
+    pub fn set_footprint(&mut self, footprint: Option<PixelFootprint>) {
+        self.footprint = footprint;
+    }
+    /// The camera footprint, if set.
+    pub fn footprint(&self) -> Option<&PixelFootprint> {
+        self.footprint.as_ref()
     }
 
     /// Bounds of all geometry.
@@ -211,7 +226,9 @@ impl Scene {
     }
 
     /// The BSDF at a hit (`None` for interface materials), with the
-    /// material's textures evaluated for `lambda`. Mix materials are
+    /// material's textures evaluated for `lambda`. The hit first gets its
+    /// screen-space differentials from the camera footprint (pbrt-v4's
+    /// `ComputeDifferentials` in `GetBSDF`). Mix materials are
     /// resolved to one of their materials, and a bump map replaces the
     /// hit's shading geometry (so the caller sees the bumped shading
     /// normal), as in pbrt-v4's `SurfaceInteraction::GetBSDF`.
@@ -220,6 +237,9 @@ impl Scene {
         si: &mut SurfaceInteraction,
         lambda: &mut SampledWavelengths,
     ) -> Option<Bsdf> {
+        if let Some(f) = &self.footprint {
+            f.set_differentials(si);
+        }
         let m = self.resolve_material(si)?;
         if let Some(b) = m.bump() {
             b.apply(si);

@@ -1,14 +1,16 @@
 //! `imagemap`: textures looked up in an image [pbrt-v4 `FloatImageTexture`,
 //! `SpectrumImageTexture`, `MIPMap::Filter`; book §10.4].
 //!
-//! The 2D mapping gives (s, t); t is flipped (t′ = 1 − t) because texture
-//! space has its origin at the lower left and images at the upper left. The
-//! image is read at level 0 of pbrt-v4's pyramid (the file resized to
-//! power-of-two sides, `image::resize_to_power_of_two`). With the zero
-//! footprint candela has (no ray differentials), pbrt-v4's `bilinear`,
-//! `trilinear` and `ewa` filters all reduce to bilinear interpolation at
-//! level 0, and `point` to the texel whose centre is nearest. Then the value
-//! is scaled, optionally inverted (1 − v), and clamped at 0.
+//! The 2D mapping gives (s, t) and its screen-space derivatives; t is
+//! flipped (t′ = 1 − t) because texture space has its origin at the lower
+//! left and images at the upper left (the derivatives of t are passed on
+//! unflipped, as pbrt-v4 does). `trilinear` and `ewa` filter over the MIP
+//! pyramid ([`MipPyramid`]) with those derivatives. `bilinear` interpolates
+//! and `point` takes the texel whose centre is nearest, both at level 0
+//! (pbrt-v4 reads them at the pyramid level whose texel matches the
+//! footprint; candela keeps level 0 so that scenes using the default filter
+//! render as before). Then the value is scaled, optionally inverted
+//! (1 − v), and clamped at 0.
 //!
 //! A float texture reads the first channel. A spectrum texture lifts the
 //! RGB (a grey image's value repeated) in the image's colour space with the
@@ -17,18 +19,25 @@
 //! ([`ColorSpace::sample_rgb`]), once per lookup as pbrt-v4 does.
 
 use super::{TextureEvalContext, TextureMapping2D};
-use crate::image::{MapImage, WrapMode};
+use crate::image::{MipPyramid, WrapMode};
 use crate::math::Vec2;
 use crate::spectrum::{ColorSpace, Rgb, SampledSpectrum, SampledWavelengths, SpectrumKind};
 use std::sync::Arc;
 
 /// How texels are combined at a lookup.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ImageFilter {
     /// The texel whose centre is nearest.
     Point,
     /// Bilinear interpolation of the four nearest texel centres.
     Bilinear,
+    /// Bilinear lookups at the two pyramid levels around the footprint, blended.
+    Trilinear,
+    /// Elliptically weighted average over the footprint's ellipse.
+    Ewa {
+        /// Largest ratio of the ellipse's axes (`maxanisotropy`).
+        max_anisotropy: f32,
+    },
 }
 
 /// An image texture's lookup: mapping, image, filter and value transform.
@@ -36,8 +45,8 @@ pub enum ImageFilter {
 pub struct ImageTexture {
     /// The (s, t) mapping.
     pub map: TextureMapping2D,
-    /// Level 0 of the pyramid (power-of-two sides).
-    pub image: Arc<MapImage>,
+    /// The image pyramid (level 0 only for `point` and `bilinear`).
+    pub pyramid: Arc<MipPyramid>,
     /// Addressing outside [0, 1]².
     pub wrap: WrapMode,
     /// Texel filter.
@@ -51,32 +60,53 @@ pub struct ImageTexture {
 }
 
 impl ImageTexture {
-    /// Image coordinates of a hit (t flipped).
-    fn st(&self, ctx: &TextureEvalContext) -> Vec2 {
-        let st = self.map.map(ctx).st;
-        Vec2::new(st.x, 1.0 - st.y)
+    /// Image coordinates of a hit (t flipped) and the derivative vectors
+    /// (∂s/∂x, ∂t/∂x), (∂s/∂y, ∂t/∂y).
+    fn st(&self, ctx: &TextureEvalContext) -> (Vec2, Vec2, Vec2) {
+        let c = self.map.map(ctx);
+        (
+            Vec2::new(c.st.x, 1.0 - c.st.y),
+            Vec2::new(c.dsdx, c.dtdx),
+            Vec2::new(c.dsdy, c.dtdy),
+        )
+    }
+
+    /// MIP-filtered RGB for the pyramid filters; `None` for `point` and `bilinear`.
+    fn lookup_mip(&self, (st, d0, d1): (Vec2, Vec2, Vec2)) -> Option<[f32; 3]> {
+        match self.filter {
+            ImageFilter::Point | ImageFilter::Bilinear => None,
+            ImageFilter::Trilinear => Some(self.pyramid.trilinear(st, d0, d1, self.wrap)),
+            ImageFilter::Ewa { max_anisotropy } => {
+                Some(self.pyramid.ewa(st, d0, d1, max_anisotropy, self.wrap))
+            }
+        }
     }
 
     /// Filtered RGB (grey replicated) before scaling.
-    fn lookup_rgb(&self, st: Vec2) -> [f32; 3] {
-        match self.filter {
-            ImageFilter::Bilinear => self.image.bilerp_rgb(st, self.wrap),
-            ImageFilter::Point => {
-                let (x, y) = self.image.point_texel(st);
-                self.image.texel_rgb(x, y, self.wrap)
-            }
+    fn lookup_rgb(&self, at: (Vec2, Vec2, Vec2)) -> [f32; 3] {
+        if let Some(rgb) = self.lookup_mip(at) {
+            return rgb;
+        }
+        let (image, st) = (self.pyramid.base(), at.0);
+        if self.filter == ImageFilter::Point {
+            let (x, y) = image.point_texel(st);
+            image.texel_rgb(x, y, self.wrap)
+        } else {
+            image.bilerp_rgb(st, self.wrap)
         }
     }
 
     /// Float value at a hit: first channel, scaled, inverted as 1 − v clamped at 0.
     pub fn evaluate_float(&self, ctx: &TextureEvalContext) -> f32 {
-        let st = self.st(ctx);
-        let raw = match self.filter {
-            ImageFilter::Bilinear => self.image.bilerp(st, 0, self.wrap),
-            ImageFilter::Point => {
-                let (x, y) = self.image.point_texel(st);
-                self.image.texel(x, y, 0, self.wrap)
+        let at = self.st(ctx);
+        let image = self.pyramid.base();
+        let raw = match self.lookup_mip(at) {
+            Some(rgb) => rgb[0],
+            None if self.filter == ImageFilter::Point => {
+                let (x, y) = image.point_texel(at.0);
+                image.texel(x, y, 0, self.wrap)
             }
+            None => image.bilerp(at.0, 0, self.wrap),
         };
         let v = self.scale * raw;
         if self.invert {
@@ -121,19 +151,19 @@ impl SpectrumImageTexture {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::image::PixelFormat;
+    use crate::image::{MapImage, PixelFormat};
 
     /// 2×2 grey image: top row 0, 1; bottom row 2, 3.
     fn tex(filter: ImageFilter, wrap: WrapMode) -> ImageTexture {
         ImageTexture {
             map: TextureMapping2D::UV,
-            image: Arc::new(MapImage::new(
+            pyramid: Arc::new(MipPyramid::base_only(MapImage::new(
                 2,
                 2,
                 1,
                 vec![0.0, 1.0, 2.0, 3.0],
                 PixelFormat::Float,
-            )),
+            ))),
             wrap,
             filter,
             scale: 1.0,

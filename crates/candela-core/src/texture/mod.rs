@@ -10,9 +10,11 @@
 //! position, normal, (u, v) and their screen-space derivatives. A mapping
 //! ([`TextureMapping2D`], [`TextureMapping3D`]) turns the context into
 //! texture coordinates; procedural patterns are functions of those.
-//! candela traces no ray differentials yet, so the derivatives are zero:
-//! the checkerboard's box filter then reduces to the point value and fbm
-//! sums every octave (pbrt-v4 estimates the footprint from the camera).
+//! The derivatives come from the camera's pixel footprint at every hit
+//! ([`crate::camera::PixelFootprint`], pbrt-v4's `Approximate_dp_dxy`); they
+//! size the checkerboard's box filter, fbm's octave count and the image
+//! textures' MIP level. Without a footprint (hand-built scenes, the alpha
+//! test during traversal) they are zero.
 //!
 //! Both texture kinds are closed enums. Leaves (constants) are stored
 //! inline; composite nodes hold their children behind an `Arc` built once
@@ -49,7 +51,7 @@ use std::sync::Arc;
 pub struct TextureEvalContext {
     /// Position (render space).
     pub p: Vec3,
-    /// ∂p/∂x on the image plane (zero: no ray differentials yet).
+    /// ∂p/∂x on the image plane (zero where no footprint is known).
     pub dpdx: Vec3,
     /// ∂p/∂y on the image plane.
     pub dpdy: Vec3,
@@ -72,12 +74,18 @@ pub struct TextureEvalContext {
 impl TextureEvalContext {
     /// The context of a surface hit.
     pub fn from_si(si: &SurfaceInteraction) -> Self {
+        let d = &si.diff;
         Self {
             p: si.p(),
+            dpdx: d.dpdx,
+            dpdy: d.dpdy,
             n: si.n(),
             uv: si.it.uv,
+            dudx: d.dudx,
+            dudy: d.dudy,
+            dvdx: d.dvdx,
+            dvdy: d.dvdy,
             face_index: si.face_index,
-            ..Self::default()
         }
     }
 }

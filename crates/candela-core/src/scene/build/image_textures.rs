@@ -2,17 +2,20 @@
 //!
 //! Parameters and defaults are pbrt-v4's (`FloatImageTexture::Create`,
 //! `SpectrumImageTexture::Create`): `filename` (relative to the scene file's
-//! directory), `filter` (`bilinear`; `point`; `trilinear` and `ewa` evaluate
-//! as bilinear — with a warning — because candela has no ray differentials),
-//! `maxanisotropy` (EWA only, so unused), `wrap` (`repeat`, `black`, `clamp`,
+//! directory), `filter` (`bilinear`, `point`, `trilinear`, `ewa`),
+//! `maxanisotropy` (EWA only), `wrap` (`repeat`, `black`, `clamp`,
 //! `octahedralsphere`), `scale`, `invert`, `encoding` (`sRGB` for `.png`
 //! files, else `linear`; or `gamma γ`) and the 2D mapping. As in pbrt-v4's
 //! texture cache, a file is loaded (and resized to power-of-two sides) once
-//! per wrap mode and encoding, however many textures and meanings use it.
+//! per wrap mode and encoding, however many textures and meanings use it;
+//! its MIP pyramid is built the first time a `trilinear` or `ewa` texture
+//! asks for it.
 
 use super::textures::mapping_2d;
 use super::BuildError;
-use crate::image::{read_map, resize_to_power_of_two, ColorEncoding, MapImage, WrapMode};
+use crate::image::{
+    read_map, resize_to_power_of_two, ColorEncoding, MapImage, MipPyramid, WrapMode,
+};
 use crate::spectrum::ColorSpace;
 use crate::texture::{ImageFilter, ImageTexture};
 use candela_scene::TextureDesc;
@@ -20,8 +23,8 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// A loaded image and its colour space.
-type Loaded = (Arc<MapImage>, &'static ColorSpace);
+/// A loaded image (as a pyramid) and its colour space.
+type Loaded = (Arc<MipPyramid>, &'static ColorSpace);
 
 /// Images loaded so far, by file, wrap mode and encoding.
 #[derive(Default)]
@@ -43,16 +46,12 @@ impl ImageCache {
                 format!("imagemap texture \"{}\" needs a \"filename\"", d.name),
             ));
         };
+        let max_anisotropy = p.get_float("maxanisotropy", 8.0)?;
         let filter = match p.get_string("filter", "bilinear")?.as_str() {
             "bilinear" => ImageFilter::Bilinear,
             "point" => ImageFilter::Point,
-            f @ ("trilinear" | "ewa") => {
-                self.warnings.push(format!(
-                    "{}: filter \"{f}\" of texture \"{}\" evaluates as \"bilinear\": candela traces no ray differentials",
-                    loc_of("filter"), d.name
-                ));
-                ImageFilter::Bilinear
-            }
+            "trilinear" => ImageFilter::Trilinear,
+            "ewa" => ImageFilter::Ewa { max_anisotropy },
             other => {
                 return Err(BuildError::at(
                     loc_of("filter"),
@@ -62,8 +61,6 @@ impl ImageCache {
                 ))
             }
         };
-        // Only EWA uses it; read so that it is not reported as unused.
-        let _ = p.get_float("maxanisotropy", 8.0)?;
         let wrap_name = p.get_string("wrap", "repeat")?;
         let wrap = WrapMode::parse(&wrap_name).ok_or_else(|| {
             BuildError::at(
@@ -81,11 +78,18 @@ impl ImageCache {
                 format!("unknown color encoding \"{enc_name}\" (known: linear, sRGB, \"gamma <value>\")"),
             )
         })?;
-        let (image, color_space) =
-            self.load(path, wrap, &enc_name, encoding, loc_of("filename"))?;
+        let needs_levels = matches!(filter, ImageFilter::Trilinear | ImageFilter::Ewa { .. });
+        let (pyramid, color_space) = self.load(
+            path,
+            wrap,
+            &enc_name,
+            encoding,
+            needs_levels,
+            loc_of("filename"),
+        )?;
         Ok(ImageTexture {
             map: mapping_2d(d)?,
-            image,
+            pyramid,
             wrap,
             filter,
             scale: p.get_float("scale", 1.0)?,
@@ -127,18 +131,25 @@ impl ImageCache {
         Ok(image)
     }
 
-    /// The image at `path` resized for `wrap`, loaded on first request.
+    /// The image at `path` resized for `wrap`, loaded on first request,
+    /// with its upper MIP levels when `levels` asks for them.
     fn load(
         &mut self,
         path: PathBuf,
         wrap: WrapMode,
         enc_name: &str,
         encoding: ColorEncoding,
+        levels: bool,
         loc: &candela_scene::Loc,
     ) -> Result<Loaded, BuildError> {
         let key = (path, wrap, enc_name.to_string());
-        if let Some(l) = self.loaded.get(&key) {
-            return Ok(l.clone());
+        if let Some((pyramid, cs)) = self.loaded.get(&key) {
+            if levels && !pyramid.is_complete() {
+                let full = (Arc::new(MipPyramid::build(pyramid.base().clone())), *cs);
+                self.loaded.insert(key, full.clone());
+                return Ok(full);
+            }
+            return Ok((pyramid.clone(), cs));
         }
         let path = &key.0;
         if !path.is_file() {
@@ -151,10 +162,15 @@ impl ImageCache {
         if let Some(w) = file.warning {
             self.warnings.push(format!("{loc}: {w}"));
         }
-        let image = Arc::new(resize_to_power_of_two(&file.image, wrap));
+        let base = resize_to_power_of_two(&file.image, wrap);
+        let pyramid = if levels {
+            MipPyramid::build(base)
+        } else {
+            MipPyramid::base_only(base)
+        };
         // Fit the RGB table now rather than on the first lookup, mid-render.
         file.color_space.rgb_table();
-        let l = (image, file.color_space);
+        let l = (Arc::new(pyramid), file.color_space);
         self.loaded.insert(key, l.clone());
         Ok(l)
     }
