@@ -8,7 +8,8 @@
 //!   ∂p′/∂u ≈ ∂p/∂u + (∂d/∂u) n + d ∂n/∂u,   and likewise for v,
 //!
 //! with ∂d/∂u taken by a forward difference over Δu = ½(|∂u/∂x| + |∂u/∂y|),
-//! or 0.0005 without screen-space differentials (candela's case for now).
+//! from the hit's screen-space differentials (the camera footprint), or
+//! 0.0005 where those are zero.
 //! The shading normal becomes ∂p′/∂u × ∂p′/∂v, turned to the geometric
 //! normal's side.
 //!

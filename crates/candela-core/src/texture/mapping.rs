@@ -8,8 +8,8 @@
 //! directive, so each non-uv mapping holds texture-from-render.
 //!
 //! Each mapping also carries the screen-space derivatives of its output
-//! (for filtering) forward from those of the hit; they are zero while candela
-//! traces no ray differentials.
+//! (for filtering) forward from those of the hit (the camera footprint's,
+//! [`crate::camera::PixelFootprint`]).
 
 use super::TextureEvalContext;
 use crate::math::{Transform, Vec2, Vec3, INV_2PI, INV_PI, PI};

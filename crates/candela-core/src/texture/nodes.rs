@@ -149,7 +149,7 @@ pub fn checkerboard_weight(map: &CheckerMap, ctx: &TextureEvalContext) -> f32 {
 /// of radius `r`. A tent is a box convolved with itself, so the average is
 /// the second central difference of the wave's second antiderivative D:
 /// (D(x + r) − 2D(x) + D(x − r)) / r² [pbrt-v4 §10.5.1]. A footprint inside
-/// one cell (including r = 0, candela's case until ray differentials exist)
+/// one cell (including r = 0, where the hit has no footprint)
 /// is the exact point value.
 fn filtered_square_wave(x: f32, r: f32) -> f32 {
     if (x - r).floor() == (x + r).floor() {

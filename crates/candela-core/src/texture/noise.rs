@@ -16,8 +16,8 @@
 //! [pbrt-v4 §10.6.1, after Perlin 1985]. The number of octaves is limited by
 //! the texture-space footprint (`dpdx`, `dpdy`) so that no octave is finer
 //! than the pixel: n = clamp(−1 − ½ log₂ max(|dpdx|², |dpdy|²), 0, max)
-//! [pbrt-v4 §10.6.2]. candela traces no ray differentials yet, so the
-//! footprint is zero and every octave is summed.
+//! [pbrt-v4 §10.6.2]. With a zero footprint (no camera footprint known)
+//! every octave is summed.
 
 use super::perm::PERM;
 use crate::math::Vec3;
