@@ -40,11 +40,6 @@ pub struct MipPyramid {
 }
 
 impl MipPyramid {
-    /// A pyramid of level 0 only.
-    pub fn base_only(base: MapImage) -> Self {
-        Self { levels: vec![base] }
-    }
-
     /// All levels above `base` (power-of-two sides) by 2×2 box averages.
     pub fn build(base: MapImage) -> Self {
         let mut levels = Vec::new();
@@ -83,22 +78,13 @@ impl MipPyramid {
         &self.levels
     }
 
-    /// True when the levels above 0 have been built.
-    pub fn is_complete(&self) -> bool {
-        let top = self.levels.last().map(|l| (l.width, l.height));
-        top == Some((1, 1))
-    }
-
     /// Trilinear lookup at `st` with screen-space derivative vectors
     /// `dst0` = (∂s/∂x, ∂t/∂x) and `dst1` = (∂s/∂y, ∂t/∂y).
     pub fn trilinear(&self, st: Vec2, dst0: Vec2, dst1: Vec2, wrap: WrapMode) -> [f32; 3] {
-        let n = self.levels.len();
-        let width = 2.0 * dst0.abs().max_element().max(dst1.abs().max_element());
-        let level = (n - 1) as f32 + width.max(1e-8).log2();
-        if level >= (n - 1) as f32 {
-            return self.levels[n - 1].texel_rgb(0, 0, wrap);
-        }
-        let i = level.floor().max(0.0) as usize;
+        let level = self.footprint_level(dst0, dst1);
+        let Some(i) = self.finite_level(level) else {
+            return self.top_texel(wrap);
+        };
         if i == 0 {
             return self.levels[0].bilerp_rgb(st, wrap);
         }
@@ -107,6 +93,46 @@ impl MipPyramid {
             self.levels[i + 1].bilerp_rgb(st, wrap),
         );
         lerp3(level - i as f32, a, b)
+    }
+
+    /// pbrt-v4's continuous level ℓ = L − 1 + log₂ w of a footprint of width
+    /// w = 2·max(|∂s/∂x|, |∂t/∂x|, |∂s/∂y|, |∂t/∂y|).
+    pub fn footprint_level(&self, dst0: Vec2, dst1: Vec2) -> f32 {
+        let width = 2.0 * dst0.abs().max_element().max(dst1.abs().max_element());
+        (self.levels.len() - 1) as f32 + width.max(1e-8).log2()
+    }
+
+    /// ⌊ℓ⌋ clamped at 0, or `None` when the footprint covers the whole
+    /// texture (ℓ ≥ L − 1: pbrt-v4 then returns the single top texel).
+    pub fn finite_level(&self, level: f32) -> Option<usize> {
+        (level < (self.levels.len() - 1) as f32).then(|| level.floor().max(0.0) as usize)
+    }
+
+    /// The one texel of the coarsest level.
+    pub fn top_texel(&self, wrap: WrapMode) -> [f32; 3] {
+        self.levels[self.levels.len() - 1].texel_rgb(0, 0, wrap)
+    }
+
+    /// pbrt-v4's `point` and `bilinear` filters: one lookup at level ⌊ℓ⌋
+    /// (level 0 whenever the texture is magnified), or the top texel.
+    pub fn single_level(
+        &self,
+        st: Vec2,
+        dst0: Vec2,
+        dst1: Vec2,
+        wrap: WrapMode,
+        point: bool,
+    ) -> [f32; 3] {
+        let Some(i) = self.finite_level(self.footprint_level(dst0, dst1)) else {
+            return self.top_texel(wrap);
+        };
+        let image = &self.levels[i];
+        if point {
+            let (x, y) = image.point_texel(st);
+            image.texel_rgb(x, y, wrap)
+        } else {
+            image.bilerp_rgb(st, wrap)
+        }
     }
 
     /// EWA lookup (see the module docs); `max_anisotropy` bounds the
@@ -222,7 +248,6 @@ mod tests {
         let p = MipPyramid::build(noise(16, 4));
         let sizes: Vec<_> = p.levels().iter().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, [(16, 4), (8, 2), (4, 1), (2, 1), (1, 1)]);
-        assert!(p.is_complete());
         for k in 1..p.levels().len() {
             let (lo, hi) = (&p.levels()[k - 1], &p.levels()[k]);
             for y in 0..hi.height {

@@ -45,7 +45,7 @@ pub enum ImageFilter {
 pub struct ImageTexture {
     /// The (s, t) mapping.
     pub map: TextureMapping2D,
-    /// The image pyramid (level 0 only for `point` and `bilinear`).
+    /// The image and its MIP levels.
     pub pyramid: Arc<MipPyramid>,
     /// Addressing outside [0, 1]².
     pub wrap: WrapMode,
@@ -71,43 +71,22 @@ impl ImageTexture {
         )
     }
 
-    /// MIP-filtered RGB for the pyramid filters; `None` for `point` and `bilinear`.
-    fn lookup_mip(&self, (st, d0, d1): (Vec2, Vec2, Vec2)) -> Option<[f32; 3]> {
+    /// Filtered RGB (grey replicated) before scaling. Every filter picks
+    /// its MIP level from the footprint as pbrt-v4's `MIPMap::Filter` does:
+    /// `point` and `bilinear` read level ⌊ℓ⌋ (level 0 when magnified).
+    fn lookup_rgb(&self, (st, d0, d1): (Vec2, Vec2, Vec2)) -> [f32; 3] {
+        let p = &self.pyramid;
         match self.filter {
-            ImageFilter::Point | ImageFilter::Bilinear => None,
-            ImageFilter::Trilinear => Some(self.pyramid.trilinear(st, d0, d1, self.wrap)),
-            ImageFilter::Ewa { max_anisotropy } => {
-                Some(self.pyramid.ewa(st, d0, d1, max_anisotropy, self.wrap))
-            }
-        }
-    }
-
-    /// Filtered RGB (grey replicated) before scaling.
-    fn lookup_rgb(&self, at: (Vec2, Vec2, Vec2)) -> [f32; 3] {
-        if let Some(rgb) = self.lookup_mip(at) {
-            return rgb;
-        }
-        let (image, st) = (self.pyramid.base(), at.0);
-        if self.filter == ImageFilter::Point {
-            let (x, y) = image.point_texel(st);
-            image.texel_rgb(x, y, self.wrap)
-        } else {
-            image.bilerp_rgb(st, self.wrap)
+            ImageFilter::Point => p.single_level(st, d0, d1, self.wrap, true),
+            ImageFilter::Bilinear => p.single_level(st, d0, d1, self.wrap, false),
+            ImageFilter::Trilinear => p.trilinear(st, d0, d1, self.wrap),
+            ImageFilter::Ewa { max_anisotropy } => p.ewa(st, d0, d1, max_anisotropy, self.wrap),
         }
     }
 
     /// Float value at a hit: first channel, scaled, inverted as 1 − v clamped at 0.
     pub fn evaluate_float(&self, ctx: &TextureEvalContext) -> f32 {
-        let at = self.st(ctx);
-        let image = self.pyramid.base();
-        let raw = match self.lookup_mip(at) {
-            Some(rgb) => rgb[0],
-            None if self.filter == ImageFilter::Point => {
-                let (x, y) = image.point_texel(at.0);
-                image.texel(x, y, 0, self.wrap)
-            }
-            None => image.bilerp(at.0, 0, self.wrap),
-        };
+        let raw = self.lookup_rgb(self.st(ctx))[0];
         let v = self.scale * raw;
         if self.invert {
             (1.0 - v).max(0.0)
@@ -157,7 +136,7 @@ mod tests {
     fn tex(filter: ImageFilter, wrap: WrapMode) -> ImageTexture {
         ImageTexture {
             map: TextureMapping2D::UV,
-            pyramid: Arc::new(MipPyramid::base_only(MapImage::new(
+            pyramid: Arc::new(MipPyramid::build(MapImage::new(
                 2,
                 2,
                 1,

@@ -7,9 +7,9 @@
 //! `octahedralsphere`), `scale`, `invert`, `encoding` (`sRGB` for `.png`
 //! files, else `linear`; or `gamma γ`) and the 2D mapping. As in pbrt-v4's
 //! texture cache, a file is loaded (and resized to power-of-two sides) once
-//! per wrap mode and encoding, however many textures and meanings use it;
-//! its MIP pyramid is built the first time a `trilinear` or `ewa` texture
-//! asks for it.
+//! per wrap mode and encoding, however many textures and meanings use it,
+//! with its MIP pyramid: every filter reads the level pbrt-v4's
+//! `MIPMap::Filter` picks for the footprint.
 
 use super::textures::mapping_2d;
 use super::BuildError;
@@ -78,15 +78,8 @@ impl ImageCache {
                 format!("unknown color encoding \"{enc_name}\" (known: linear, sRGB, \"gamma <value>\")"),
             )
         })?;
-        let needs_levels = matches!(filter, ImageFilter::Trilinear | ImageFilter::Ewa { .. });
-        let (pyramid, color_space) = self.load(
-            path,
-            wrap,
-            &enc_name,
-            encoding,
-            needs_levels,
-            loc_of("filename"),
-        )?;
+        let (pyramid, color_space) =
+            self.load(path, wrap, &enc_name, encoding, loc_of("filename"))?;
         Ok(ImageTexture {
             map: mapping_2d(d)?,
             pyramid,
@@ -131,25 +124,19 @@ impl ImageCache {
         Ok(image)
     }
 
-    /// The image at `path` resized for `wrap`, loaded on first request,
-    /// with its upper MIP levels when `levels` asks for them.
+    /// The image at `path` resized for `wrap` and its MIP pyramid (every
+    /// filter picks a level, as in pbrt-v4), loaded on first request.
     fn load(
         &mut self,
         path: PathBuf,
         wrap: WrapMode,
         enc_name: &str,
         encoding: ColorEncoding,
-        levels: bool,
         loc: &candela_scene::Loc,
     ) -> Result<Loaded, BuildError> {
         let key = (path, wrap, enc_name.to_string());
-        if let Some((pyramid, cs)) = self.loaded.get(&key) {
-            if levels && !pyramid.is_complete() {
-                let full = (Arc::new(MipPyramid::build(pyramid.base().clone())), *cs);
-                self.loaded.insert(key, full.clone());
-                return Ok(full);
-            }
-            return Ok((pyramid.clone(), cs));
+        if let Some(l) = self.loaded.get(&key) {
+            return Ok(l.clone());
         }
         let path = &key.0;
         if !path.is_file() {
@@ -163,11 +150,7 @@ impl ImageCache {
             self.warnings.push(format!("{loc}: {w}"));
         }
         let base = resize_to_power_of_two(&file.image, wrap);
-        let pyramid = if levels {
-            MipPyramid::build(base)
-        } else {
-            MipPyramid::base_only(base)
-        };
+        let pyramid = MipPyramid::build(base);
         // Fit the RGB table now rather than on the first lookup, mid-render.
         file.color_space.rgb_table();
         let l = (Arc::new(pyramid), file.color_space);
