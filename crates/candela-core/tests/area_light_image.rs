@@ -236,7 +236,10 @@ fn alpha_checkerboard_emitter_lights_the_floor_with_its_unmasked_half() {
             );
             let (m, se, e) = residual(&img, want);
             eprintln!("{what} {integrator}: residual {m:.6} ± {se:.6} of mean {e:.5}");
-            assert!(m.abs() <= 5.0 * se + 0.02 * e, "{what} {integrator}: {m} (σ {se}, mean {e})");
+            assert!(
+                m.abs() <= 5.0 * se + 0.02 * e,
+                "{what} {integrator}: {m} (σ {se}, mean {e})"
+            );
         }
     }
     // Constant α = 0 switches the emitter off.
@@ -322,7 +325,10 @@ fn l_with_filename_and_missing_images_are_errors_at_their_directive() {
         "",
     );
     let e = build_error(&dir, &both);
-    assert!(e.contains("e.pbrt:10:1") && e.contains("\"L\" and \"filename\""), "{e}");
+    assert!(
+        e.contains("e.pbrt:10:1") && e.contains("\"L\" and \"filename\""),
+        "{e}"
+    );
     let missing = emitter_view(
         r#"AreaLightSource "diffuse"   "string filename" "nope.png""#,
         "",

@@ -42,7 +42,11 @@ fn lights(im: &Arc<MapImage>, two_sided: bool) -> Vec<DiffuseAreaLight> {
 
 /// π·(sides)·∫ L dA over the unit square by an n×n midpoint rule, L from
 /// `l()` along the normal (one-sided: the front side only).
-fn phi_by_quadrature(l: &DiffuseAreaLight, sides: f32, lam: &SampledWavelengths) -> SampledSpectrum {
+fn phi_by_quadrature(
+    l: &DiffuseAreaLight,
+    sides: f32,
+    lam: &SampledWavelengths,
+) -> SampledSpectrum {
     const N_S: usize = crate::spectrum::N_SPECTRUM_SAMPLES;
     let n = 400;
     // f64 sums: 160 000 f32 additions would lose ~10⁻⁴.
@@ -74,7 +78,11 @@ fn uniform_image_phi_is_pi_a_l() {
     let lam = lambda();
     let rgb = [0.3, 0.5, 0.9];
     let cs = ColorSpace::srgb();
-    let l = cs.sample_rgb(Rgb::new(rgb[0], rgb[1], rgb[2]), SpectrumKind::Illuminant, &lam) * 1.3;
+    let l = cs.sample_rgb(
+        Rgb::new(rgb[0], rgb[1], rgb[2]),
+        SpectrumKind::Illuminant,
+        &lam,
+    ) * 1.3;
     for two in [false, true] {
         let sides = if two { 2.0 } else { 1.0 };
         for light in lights(&image(2, 2, &[rgb; 4]), two) {
@@ -100,7 +108,12 @@ fn image_phi_matches_the_integral_over_a_unit_square_quad() {
         let cs = ColorSpace::srgb();
         let two_c = cs.sample_rgb(Rgb::new(0.2, 0.4, 0.6), SpectrumKind::Illuminant, &lam);
         let sides = if two { 2.0 } else { 1.0 };
-        assert_close(&total, &(two_c * (1.3 * sides * PI)), 1e-4, "2c closed form");
+        assert_close(
+            &total,
+            &(two_c * (1.3 * sides * PI)),
+            1e-4,
+            "2c closed form",
+        );
     }
 }
 
