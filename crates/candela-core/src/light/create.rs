@@ -15,6 +15,7 @@
 //! | goniometric | `power` Φ_v > 0 | Φ_v / (4π·mean Y), Y = (R + G + B)/3 of the map |
 //! | projection | `power` Φ_v > 0 | Φ_v / (A·mean_p(Y_lum(rgb_p)·cos³θ_p)), A = 4·tan²(fov/2)·max(a, 1/a) |
 //! | diffuse area | `power` Φ_v > 0 | Φ_v / (π·A·(2 if two-sided else 1)) |
+//! | diffuse area, image | `power` Φ_v > 0 | Φ_v / (π·A·(2 if two-sided else 1)·mean Y_lum(rgb)) |
 //! | distant | `illuminance` E_v > 0 | E_v (pbrt-v4 after issue #130; was E_v/(−w.y)) |
 //! | uniform infinite | `illuminance` E_v > 0 | E_v / π (illuminance on an upward patch) |
 //! | image infinite | `illuminance` E_v > 0 | E_v / k, k = (2π/N)·Σ_{texels with z > 0} Y(rgb)·cos θ |
@@ -34,6 +35,13 @@
 //! below 10⁻³ for images of more than ~30 texels across. Projection and
 //! goniometric lights normalise by the photometric value of the image's
 //! colour-space illuminant and of `I` respectively, as pbrt-v4 does.
+//!
+//! A diffuse area light with an image normalises by the illuminant of the
+//! scene's current colour space (not the image's), as pbrt-v4's
+//! `DiffuseAreaLight::Create` does; for `power`, its k_e is the mean over
+//! texels of Y_lum(rgb) (the image colour space's luminance row, texels
+//! unclamped) times the shape's own area: each triangle of a mesh is one
+//! light and receives the whole `power`, as in pbrt-v4.
 //!
 //! An image infinite light normalises by its colour space's illuminant (its
 //! texels are RGB illuminant spectra) and, for `illuminance`, by pbrt-v4's
@@ -158,6 +166,36 @@ pub fn diffuse_area_light(
         sc *= phi_v / k_e;
     }
     DiffuseAreaLight::new(shape, l, sc, two_sided)
+}
+
+/// pbrt-v4 `"diffuse"` area light with a `filename` RGB `image` in colour
+/// space `image_cs`, in a scene whose current colour space is `scene_cs`:
+/// `scale`, `twosided`, optional `power` (lm).
+pub fn diffuse_area_image_light(
+    shape: Shape,
+    image: Arc<MapImage>,
+    image_cs: &'static ColorSpace,
+    scene_cs: &ColorSpace,
+    scale: f32,
+    two_sided: bool,
+    power: Option<f32>,
+) -> DiffuseAreaLight {
+    let mut sc = nit_scale(scale, &scene_cs.illuminant);
+    if let Some(phi_v) = given(power) {
+        let lum = image_cs.xyz_from_rgb.row(1);
+        let sum: f64 = image
+            .data
+            .chunks_exact(3)
+            .map(|t| lum.dot(Vec3::new(t[0], t[1], t[2])) as f64)
+            .sum();
+        let mean_y = (sum / (image.width * image.height) as f64) as f32;
+        let sides = if two_sided { 2.0 } else { 1.0 };
+        let k_e = mean_y * sides * shape.area() * PI;
+        if k_e > 0.0 {
+            sc *= phi_v / k_e;
+        }
+    }
+    DiffuseAreaLight::new_image(shape, image, image_cs, sc, two_sided)
 }
 
 /// pbrt-v4 `"infinite"` with a constant `L`: optional `illuminance` (lx) on

@@ -13,38 +13,163 @@
 //! two-sided light first picks a side with probability 1/2, so
 //! p_dir = cos θ/(2π). Then `β₀ = L·cos θ·A·π/cos θ = πAL = Φ` (2πAL
 //! two-sided) for every uniform-area sample.
+//!
+//! **Image emission** [pbrt-v4 `DiffuseAreaLight::L`, `filename`]. With an
+//! RGB image instead of a spectrum, the radiance at a point of surface
+//! coordinates (u, v) is `scale·spectrum(rgb)`, where rgb is the bilinear
+//! lookup of the image at (u, 1 − v) (edge texels extended, so row 0 is at
+//! v = 1 as for image textures) with negative components clamped to zero,
+//! lifted as an RGB illuminant spectrum of the image's colour space. The
+//! sampling above is unchanged (uniform by area, cosine in direction), so
+//! it stays unbiased; β₀ = L·cos θ/(p_pos·p_dir) then varies with the texel.
+//!
+//! **Power of an image emitter.** The exact power is
+//! Φ = π·(2 if two-sided)·scale·∫_A spectrum(rgb(uv(p))) dA. Like pbrt-v4's
+//! `Phi`, candela takes `A·mean over texels of spectrum(texel)`, which is
+//! that integral when the shape's (u, v) covers the unit square uniformly
+//! by area (a bilinear patch, or the sum over the two triangles of a quad
+//! with uv = the unit square) and the image's colours differ only in
+//! brightness (the lift is then linear in rgb). A single triangle of such a
+//! quad gets the whole image's mean rather than that of the half it covers.
+//! Φ only weights light selection (the power light sampler), so this costs
+//! variance, never bias.
+//!
+//! **Alpha** [pbrt-v4 `DiffuseAreaLight::AlphaMasked`]. An emitter whose
+//! shape has an `alpha` texture emits nothing where it is masked: α ≥ 1 is
+//! never masked, α ≤ 0 always, and 0 < α < 1 is masked when pbrt-v4's
+//! `HashFloat` of the point's bytes exceeds α. The texture sees only the
+//! point and its (u, v), as in pbrt-v4. Hits on the shape are alpha-tested
+//! separately with a hash of the ray ([`crate::scene::Primitive`]), so a
+//! camera ray sees a fractional α with expected emission α² (hit test ×
+//! emission mask, independent hashes), while light sampling and emission
+//! sampling see α: as in pbrt-v4, whose renders candela follows here, the
+//! strategies then disagree, and only 0/1 alpha is consistent. Φ ignores
+//! alpha, as pbrt-v4's does.
 
 use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
+use crate::image::{MapImage, WrapMode};
 use crate::interaction::Interaction;
 use crate::math::{Frame, Vec2, Vec3, PI};
 use crate::sampling::{
-    cosine_hemisphere_pdf, sample_cosine_hemisphere, PdfArea, PdfSolidAngle, ONE_MINUS_EPSILON,
+    cosine_hemisphere_pdf, murmur_hash64a, sample_cosine_hemisphere, PdfArea, PdfSolidAngle,
+    ONE_MINUS_EPSILON,
 };
 use crate::shape::{Shape, ShapeSampleContext};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{ColorSpace, Rgb, SampledSpectrum, SampledWavelengths, SpectrumKind};
+use crate::texture::{FloatTexture, TextureEvalContext};
+use std::sync::Arc;
+
+/// What a diffuse area light emits before `scale`.
+#[derive(Clone, Debug)]
+enum Emission {
+    /// The same spectrum everywhere.
+    Spectrum(LightSpectrum),
+    /// An RGB image over the surface's (u, v), in `color_space`.
+    Image {
+        image: Arc<MapImage>,
+        color_space: &'static ColorSpace,
+    },
+}
 
 /// A Lambertian emitter on a shape given in render space.
 #[derive(Clone, Debug)]
 pub struct DiffuseAreaLight {
     shape: Shape,
     area: f32,
-    lemit: LightSpectrum,
+    emission: Emission,
     scale: f32,
     two_sided: bool,
+    /// The shape's cut-out mask (`None`: emits everywhere).
+    alpha: Option<FloatTexture>,
+}
+
+/// pbrt-v4's `HashFloat(p)`: MurmurHash64A of the coordinates' bytes, low
+/// 32 bits scaled to [0, 1).
+fn hash_float(p: Vec3) -> f32 {
+    let mut bytes = [0u8; 12];
+    for (i, v) in [p.x, p.y, p.z].iter().enumerate() {
+        bytes[4 * i..4 * i + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    (murmur_hash64a(&bytes, 0) as u32) as f32 * (1.0 / 4_294_967_296.0)
 }
 
 impl DiffuseAreaLight {
     /// Emitter of radiance `scale·lemit` on `shape` (already in render
     /// space); one-sided lights emit on the side of the shape's normal.
     pub fn new(shape: Shape, lemit: LightSpectrum, scale: f32, two_sided: bool) -> Self {
+        Self::with_emission(shape, Emission::Spectrum(lemit), scale, two_sided)
+    }
+
+    /// Emitter of radiance `scale·spectrum(rgb)`, rgb looked up in the RGB
+    /// `image` (colour space `color_space`) at (u, 1 − v); see the module doc.
+    pub fn new_image(
+        shape: Shape,
+        image: Arc<MapImage>,
+        color_space: &'static ColorSpace,
+        scale: f32,
+        two_sided: bool,
+    ) -> Self {
+        assert_eq!(image.channels, 3, "area light images are RGB");
+        let emission = Emission::Image { image, color_space };
+        Self::with_emission(shape, emission, scale, two_sided)
+    }
+
+    fn with_emission(shape: Shape, emission: Emission, scale: f32, two_sided: bool) -> Self {
         let area = shape.area();
         Self {
             shape,
             area,
-            lemit,
+            emission,
             scale,
             two_sided,
+            alpha: None,
         }
+    }
+
+    /// The same light with its emission masked by the shape's `alpha` texture.
+    pub fn with_alpha(mut self, alpha: Option<FloatTexture>) -> Self {
+        self.alpha = alpha;
+        self
+    }
+
+    /// True when the emission comes from an image.
+    pub fn has_image(&self) -> bool {
+        matches!(self.emission, Emission::Image { .. })
+    }
+
+    /// True when an alpha texture cuts the emission.
+    pub fn has_alpha(&self) -> bool {
+        self.alpha.is_some()
+    }
+
+    /// pbrt-v4's stochastic alpha test of point `p` with coordinates `uv`.
+    fn alpha_masked(&self, p: Vec3, uv: Vec2) -> bool {
+        let Some(alpha) = &self.alpha else {
+            return false;
+        };
+        let ctx = TextureEvalContext {
+            p,
+            uv,
+            ..TextureEvalContext::default()
+        };
+        let a = alpha.evaluate(&ctx);
+        if a >= 1.0 {
+            return false;
+        }
+        if a <= 0.0 {
+            return true;
+        }
+        hash_float(p) > a
+    }
+
+    /// `spectrum(rgb)` of one RGB triple clamped at zero, before `scale`.
+    fn rgb_spectrum(
+        cs: &ColorSpace,
+        rgb: [f32; 3],
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let rgb = Rgb::new(rgb[0].max(0.0), rgb[1].max(0.0), rgb[2].max(0.0));
+        cs.sample_rgb(rgb, SpectrumKind::Illuminant, lambda)
     }
 
     /// The emitting shape.
@@ -66,20 +191,32 @@ impl DiffuseAreaLight {
         }
     }
 
-    /// Radiance leaving surface point `p` (normal `n`) towards `w`; zero on
-    /// the back side of a one-sided light.
+    /// Radiance leaving surface point `p` (normal `n`, coordinates `uv`)
+    /// towards `w`; zero on the back side of a one-sided light and where
+    /// alpha masks the point.
     pub fn l(
         &self,
-        _p: Vec3,
+        p: Vec3,
         n: Vec3,
-        _uv: Vec2,
+        uv: Vec2,
         w: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
         if !self.two_sided && n.dot(w) < 0.0 {
             return SampledSpectrum::zero();
         }
-        self.lemit.sample(lambda) * self.scale
+        if self.alpha_masked(p, uv) {
+            return SampledSpectrum::zero();
+        }
+        match &self.emission {
+            Emission::Spectrum(s) => s.sample(lambda) * self.scale,
+            Emission::Image { image, color_space } => {
+                // [pbrt-v4 `DiffuseAreaLight::L`]: v flipped, bilinear, edges clamped.
+                let st = Vec2::new(uv.x, 1.0 - uv.y);
+                let rgb = image.bilerp_rgb(st, WrapMode::Clamp);
+                Self::rgb_spectrum(color_space, rgb, lambda) * self.scale
+            }
+        }
     }
 
     /// Samples a point on the shape as seen from `ctx`.
@@ -121,6 +258,9 @@ impl DiffuseAreaLight {
         lambda: &SampledWavelengths,
     ) -> Option<LightLeSample> {
         let ss = self.shape.sample_area(u1)?;
+        if self.alpha_masked(ss.intr.p, ss.intr.uv) {
+            return None;
+        }
         let (w_local, pdf_dir) = if self.two_sided {
             let front = u2.x < 0.5;
             let ux = if front {
@@ -167,9 +307,20 @@ impl DiffuseAreaLight {
         (self.shape.pdf_area(intr), PdfSolidAngle(pdf_dir))
     }
 
-    /// Φ = πAL, doubled when two-sided (seed eq. 二.7).
+    /// Φ = πAL, doubled when two-sided (seed eq. 二.7); for an image, L is
+    /// the mean of the texels' spectra (pbrt-v4's `Phi`; see the module doc).
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
-        self.lemit.sample(lambda) * (sides * self.scale * self.area * PI)
+        let l = match &self.emission {
+            Emission::Spectrum(s) => s.sample(lambda),
+            Emission::Image { image, color_space } => {
+                let mut sum = SampledSpectrum::zero();
+                for t in image.data.chunks_exact(3) {
+                    sum += Self::rgb_spectrum(color_space, [t[0], t[1], t[2]], lambda);
+                }
+                sum * (1.0 / (image.width * image.height) as f32)
+            }
+        };
+        l * (sides * self.scale * self.area * PI)
     }
 }

@@ -143,10 +143,20 @@ impl BdptIntegrator {
             heuristic: self.settings.heuristic,
             scratch: Default::default(),
         };
+        // s = 1 resamples the light (`connect_light`) and does not use the
+        // light subpath, so it runs even when that subpath is empty because
+        // its emission sample found no light (a black texel, an alpha-masked
+        // point): otherwise the s = 1 share of the MIS weights would be lost
+        // with the probability of that failure. (pbrt-v4 loops s to the
+        // subpath's length and loses it: its BDPT is dark on such emitters.)
+        let s_max = light.len().max(1);
         for t in 1..=cam.len() {
-            for s in 0..=light.len() {
+            for s in 0..=s_max {
                 if s + t < 2 || s + t - 2 > max_depth || (s == 0 && t == 1) {
                     continue;
+                }
+                if s > light.len() && t == 1 {
+                    continue; // s = 1, t = 1 joins the subpath's own vertex.
                 }
                 if let Some(c) = connect(&cx, &light, &cam, s, t, sampler) {
                     visit(s, t, &c, &lambda);

@@ -5,6 +5,7 @@
 //! |mean − expected| ≤ 5·s/√n + b, with s measured in the same run and b a
 //! stated round-off allowance.
 
+mod area_image;
 mod chi2;
 mod fixtures;
 mod image_infinite;

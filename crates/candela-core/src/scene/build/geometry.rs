@@ -4,7 +4,7 @@
 //! (or that belongs to a moving instance) is built in object space and
 //! placed in a [`MovingGroup`] with its [`AnimatedTransform`].
 
-use super::lights::area_light;
+use super::lights::area_light_spec;
 use super::materials::MaterialNames;
 use super::shapes::build_shape;
 use super::textures::{Source, Textures};
@@ -176,24 +176,25 @@ fn add_shape(
         return Ok(());
     }
     let shapes = build_shape(s, &render_from_object)?;
+    let spec = s
+        .area_light
+        .as_ref()
+        .map(|a| area_light_spec(a, warnings))
+        .transpose()?;
     let alpha = match alpha {
-        // pbrt-v4 masks the emission by alpha and skips alpha-0 hits: the
-        // emitter neither shows nor lights anything, so it is left out
-        // (after its shape and light were checked like any other).
-        Alpha::Off => {
-            if let (Some(a), Some(shape)) = (&s.area_light, shapes.first()) {
-                area_light(a, shape, &s.loc)?;
-            }
-            return Ok(());
-        }
+        // An emitter with constant alpha 0 is switched off: it is never hit
+        // and candela leaves it out (after its light was checked like any
+        // other). pbrt-v4 instead keeps it as an invisible light that still
+        // illuminates through light sampling (see `Alpha`).
+        Alpha::Off => return Ok(()),
         Alpha::Mask(a) => a,
     };
     let (prims, lights) = (&mut sink.prims, &mut sink.lights);
     prims.reserve(shapes.len());
     for shape in shapes {
-        let area_light = match &s.area_light {
-            Some(a) => {
-                lights.push(area_light(a, &shape, &s.loc)?);
+        let area_light = match &spec {
+            Some(spec) => {
+                lights.push(spec.light(&shape, alpha.clone()));
                 Some(LightId(lights.len() as u32 - 1))
             }
             None => None,
@@ -217,13 +218,18 @@ fn singular(loc: &candela_scene::Loc, what: &str) -> String {
 
 /// A shape's alpha: a mask (`None` when fully opaque), or `Off` for an
 /// emitter whose constant alpha is 0.
+///
+/// pbrt-v4 makes a constant-0 emitter an invisible light (typed
+/// `DeltaPosition` so that only light sampling finds it); candela switches
+/// it off instead, since a delta-typed surface light does not fit its
+/// bidirectional integrators. Any other alpha on an emitter masks its
+/// emission too (`DiffuseAreaLight`).
 enum Alpha {
     Mask(Option<FloatTexture>),
     Off,
 }
 
-/// pbrt-v4's `alpha` (float or float texture). Emitters with other cut-outs
-/// are rejected (their emission would have to be masked too).
+/// pbrt-v4's `alpha` (float or float texture).
 fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Alpha, BuildError> {
     let src = Source::new(&s.params, &s.loc, "srgb")?;
     let alpha = match tex.float_opt(&src, "alpha")? {
@@ -232,10 +238,6 @@ fn alpha(s: &ShapeDesc, tex: &mut Textures) -> Result<Alpha, BuildError> {
     };
     match (&alpha, &s.area_light) {
         (Some(FloatTexture::Constant(a)), Some(_)) if *a <= 0.0 => Ok(Alpha::Off),
-        (Some(_), Some(_)) => Err(BuildError::at(
-            s.params.param_loc("alpha").unwrap_or(&s.loc),
-            "\"alpha\" on an area light is not supported yet (only 0, which switches it off)",
-        )),
         _ => Ok(Alpha::Mask(alpha)),
     }
 }

@@ -8,6 +8,13 @@
 //! samples only directions through the portal and shows the sky only there,
 //! which renders the same wherever the portal is the scene's only opening.
 //!
+//! `AreaLightSource "diffuse"` follows pbrt-v4's `DiffuseAreaLight::Create`:
+//! `L` (default: the colour space's illuminant) or an RGB `filename` image
+//! (PNG or EXR, finite texels) looked up by the shape's (u, v), not both;
+//! `scale`, `twosided` and `power`. The directive is read once per `Shape`
+//! (one image for all the triangles of a mesh) and then gives one light
+//! per shape, carrying the shape's `alpha` texture.
+//!
 //! `"goniometric"` and `"projection"` follow their pbrt-v4 `Create`
 //! functions: `filename` (PNG or EXR) is required for a projector and
 //! optional for a goniometric light (isotropic without it, with a warning;
@@ -23,6 +30,7 @@ use crate::light::{self as create, Light};
 use crate::math::{Transform, Vec3};
 use crate::shape::Shape;
 use crate::spectrum::{ColorSpace, Spectrum};
+use crate::texture::FloatTexture;
 use candela_scene::{Entity, LightDesc, Loc, SceneDescription};
 use std::path::Path;
 use std::sync::Arc;
@@ -36,8 +44,50 @@ fn optional_positive(v: f32) -> Option<f32> {
     (v > 0.0).then_some(v)
 }
 
-/// The diffuse area light attached to one shape.
-pub fn area_light(a: &Entity, shape: &Shape, shape_loc: &Loc) -> Result<Light, BuildError> {
+/// What a diffuse area light emits: a spectrum, or an RGB image and its
+/// colour space.
+enum AreaEmission {
+    Spectrum(Spectrum),
+    Image(Arc<MapImage>, &'static ColorSpace),
+}
+
+/// A `Shape`'s `AreaLightSource`, read once and then instantiated for each
+/// shape (triangle) the directive makes.
+pub struct AreaLightSpec {
+    emission: AreaEmission,
+    scene_cs: &'static ColorSpace,
+    scale: f32,
+    two_sided: bool,
+    power: Option<f32>,
+}
+
+impl AreaLightSpec {
+    /// The light on `shape` (render space), its emission cut by `alpha`.
+    pub fn light(&self, shape: &Shape, alpha: Option<FloatTexture>) -> Light {
+        let (shape, scale, two) = (shape.clone(), self.scale, self.two_sided);
+        let light = match &self.emission {
+            AreaEmission::Spectrum(l) => {
+                create::diffuse_area_light(shape, l.clone(), scale, two, self.power)
+            }
+            AreaEmission::Image(im, cs) => create::diffuse_area_image_light(
+                shape,
+                im.clone(),
+                cs,
+                self.scene_cs,
+                scale,
+                two,
+                self.power,
+            ),
+        };
+        Light::DiffuseArea(light.with_alpha(alpha))
+    }
+}
+
+/// Reads a shape's `AreaLightSource` (pbrt-v4 has only `"diffuse"`).
+pub fn area_light_spec(
+    a: &Entity,
+    warnings: &mut Vec<String>,
+) -> Result<AreaLightSpec, BuildError> {
     if a.name != "diffuse" {
         return Err(BuildError::at(
             &a.loc,
@@ -48,32 +98,38 @@ pub fn area_light(a: &Entity, shape: &Shape, shape_loc: &Loc) -> Result<Light, B
         ));
     }
     let p = &a.params;
-    if p.get_filename("filename")?.is_some() {
-        return Err(BuildError::at(
-            &a.loc,
-            "image area lights (\"filename\") are not supported yet",
-        ));
-    }
-    let l = spectrum_param(
-        p,
-        "L",
-        SpectrumKind::Illuminant,
-        cs(&a.color_space, &a.loc)?,
-    )?
-    .unwrap_or_else(|| ColorSpace::srgb().illuminant.clone());
-    let _ = shape_loc;
-    let (scale, two_sided, power) = (
-        p.get_float("scale", 1.0)?,
-        p.get_bool("twosided", false)?,
-        optional_positive(p.get_float("power", -1.0)?),
-    );
-    Ok(Light::DiffuseArea(create::diffuse_area_light(
-        shape.clone(),
-        l,
-        scale,
-        two_sided,
-        power,
-    )))
+    let scene_cs = cs(&a.color_space, &a.loc)?;
+    let l = spectrum_param(p, "L", SpectrumKind::Illuminant, scene_cs)?;
+    let emission = match (p.get_filename("filename")?, l) {
+        (Some(_), Some(_)) => {
+            return Err(BuildError::at(
+                &a.loc,
+                "both \"L\" and \"filename\" specified for a \"diffuse\" area light",
+            ))
+        }
+        (Some(path), None) => {
+            let loc = p.param_loc("filename").unwrap_or(&a.loc);
+            let (im, image_cs) = light_image(&path, loc, warnings)?;
+            if im.channels != 3 {
+                return Err(BuildError::at(
+                    loc,
+                    format!(
+                        "{}: image provided to \"diffuse\" area light must have R, G, and B channels",
+                        path.display()
+                    ),
+                ));
+            }
+            AreaEmission::Image(Arc::new(im), image_cs)
+        }
+        (None, l) => AreaEmission::Spectrum(l.unwrap_or_else(|| scene_cs.illuminant.clone())),
+    };
+    Ok(AreaLightSpec {
+        emission,
+        scene_cs,
+        scale: p.get_float("scale", 1.0)?,
+        two_sided: p.get_bool("twosided", false)?,
+        power: optional_positive(p.get_float("power", -1.0)?),
+    })
 }
 
 /// All `LightSource` lights.

@@ -90,7 +90,12 @@ fn light_kind(l: &Light) -> &'static str {
         Light::Goniometric(_) => "goniometric",
         Light::Projection(_) => "projection",
         Light::Distant(_) => "distant",
-        Light::DiffuseArea(_) => "diffuse area",
+        Light::DiffuseArea(l) => match (l.has_image(), l.has_alpha()) {
+            (false, false) => "diffuse area",
+            (true, false) => "diffuse area (image)",
+            (false, true) => "diffuse area (alpha)",
+            (true, true) => "diffuse area (image, alpha)",
+        },
         Light::UniformInfinite(_) => "infinite (uniform)",
         Light::ImageInfinite(_) => "infinite (image)",
     }
