@@ -103,8 +103,8 @@ impl LightTracer {
         if les.pdf_pos.0 == 0.0 || les.pdf_dir.0 == 0.0 || les.l.is_black() {
             return;
         }
-        // s = 1: the light point seen directly by the camera (area lights only).
-        if let Some(it) = les.intr.filter(|it| it.is_surface()) {
+        // s = 1: the light point seen directly by the camera (visible area lights only).
+        if let Some(it) = les.intr.filter(|it| it.is_surface() && light.is_hittable()) {
             if let Some(cs) = ctx.camera.sample_wi(&it, rng.u2()) {
                 if cs.pdf.0 > 0.0 && scene.unoccluded(&it, &cs.p_lens) {
                     let le = light.l(it.p, it.n, it.uv, cs.wi, &lambda);

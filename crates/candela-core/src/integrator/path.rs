@@ -19,7 +19,7 @@ use super::{driver, Integrator, PixelEstimator, RenderContext};
 use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
 use crate::film::{RgbFilm, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
-use crate::light::{LightSampleContext, LightType};
+use crate::light::LightSampleContext;
 use crate::math::{Ray, Vec3};
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
@@ -208,10 +208,8 @@ impl PathIntegrator {
             return SampledSpectrum::zero();
         }
         let p_l = pmf * ls.pdf.0;
-        if matches!(
-            light.light_type(),
-            LightType::DeltaPosition | LightType::DeltaDirection
-        ) {
+        if !light.is_hittable() {
+            // BSDF sampling cannot find it: light sampling takes all the weight.
             return f * ls.l / p_l;
         }
         let p_bsdf = bsdf

@@ -81,6 +81,9 @@ pub struct DiffuseAreaLight {
     two_sided: bool,
     /// The shape's cut-out mask (`None`: emits everywhere).
     alpha: Option<FloatTexture>,
+    /// pbrt-v4's invisible light: a shape with constant `alpha` 0 is never
+    /// hit, yet its light still shines through light sampling.
+    invisible: bool,
 }
 
 /// pbrt-v4's `HashFloat(p)`: MurmurHash64A of the coordinates' bytes, low
@@ -123,6 +126,7 @@ impl DiffuseAreaLight {
             scale,
             two_sided,
             alpha: None,
+            invisible: false,
         }
     }
 
@@ -130,6 +134,21 @@ impl DiffuseAreaLight {
     pub fn with_alpha(mut self, alpha: Option<FloatTexture>) -> Self {
         self.alpha = alpha;
         self
+    }
+
+    /// Makes the light invisible: rays never hit it (its shape has constant
+    /// alpha 0), but it emits everywhere and is reached by light sampling
+    /// and emission sampling only [pbrt-v4 `DiffuseAreaLight::Create`, whose
+    /// "invisible area light" drops the alpha and excludes it from MIS].
+    pub fn invisible(mut self) -> Self {
+        self.invisible = true;
+        self.alpha = None;
+        self
+    }
+
+    /// True for an invisible light (see [`DiffuseAreaLight::invisible`]).
+    pub fn is_invisible(&self) -> bool {
+        self.invisible
     }
 
     /// True when the emission comes from an image.

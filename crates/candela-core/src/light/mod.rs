@@ -325,6 +325,16 @@ impl Light {
         }
     }
 
+    /// True when a ray can hit the light's emission (area and infinite
+    /// lights), so that BSDF sampling competes with light sampling in MIS;
+    /// false for delta lights and for invisible area lights.
+    pub fn is_hittable(&self) -> bool {
+        match self {
+            Light::DiffuseArea(l) => !l.is_invisible(),
+            other => !other.light_type().is_delta(),
+        }
+    }
+
     /// Total emitted power Φ (W) at the given wavelengths.
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         dispatch!(self, l => l.phi(lambda))

@@ -155,8 +155,9 @@ fn connect_camera<'a>(
     }
     let f_hat = match v.kind {
         VertexKind::Light(id) => {
-            if cx.scene.light(id).light_type() != LightType::Area {
-                return None;
+            let l = cx.scene.light(id);
+            if l.light_type() != LightType::Area || !l.is_hittable() {
+                return None; // Only a visible area light is seen directly.
             }
             let cs = cx.camera.sample_wi(&v.it, u)?;
             let le = emitted(cx.scene, v, cs.wi, cx.lambda) * cs.wi.dot(v.it.n).abs();

@@ -169,10 +169,11 @@ pub(crate) fn strategy_valid(
             return false;
         }
         if k == 1 {
-            // s = 1, t = 1: only an area light can be seen directly.
-            let area = x0
-                .light_id()
-                .is_some_and(|id| scene.light(id).light_type() == LightType::Area);
+            // s = 1, t = 1: only a visible area light can be seen directly.
+            let area = x0.light_id().is_some_and(|id| {
+                let l = scene.light(id);
+                l.light_type() == LightType::Area && l.is_hittable()
+            });
             return area;
         }
     }

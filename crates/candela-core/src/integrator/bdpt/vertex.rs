@@ -131,14 +131,10 @@ impl Vertex {
     }
 
     /// True when the vertex could be found by a path hitting it: an area or
-    /// infinite light (not a delta light).
+    /// infinite light (not a delta light, not an invisible area light).
     pub fn is_hittable_light(&self, scene: &Scene) -> bool {
-        self.light_id().is_some_and(|id| {
-            matches!(
-                scene.light(id).light_type(),
-                LightType::Area | LightType::Infinite
-            )
-        })
+        self.light_id()
+            .is_some_and(|id| scene.light(id).is_hittable())
     }
 }
 

@@ -182,11 +182,19 @@ fn add_shape(
         .map(|a| area_light_spec(a, warnings))
         .transpose()?;
     let alpha = match alpha {
-        // An emitter with constant alpha 0 is switched off: it is never hit
-        // and candela leaves it out (after its light was checked like any
-        // other). pbrt-v4 instead keeps it as an invisible light that still
-        // illuminates through light sampling (see `Alpha`).
-        Alpha::Off => return Ok(()),
+        // pbrt-v4's invisible light: an emitter with constant alpha 0 is
+        // never hit (no primitive), yet still lights the scene.
+        Alpha::Off => {
+            if let Some(spec) = &spec {
+                for shape in &shapes {
+                    let Light::DiffuseArea(l) = spec.light(shape, None) else {
+                        continue;
+                    };
+                    sink.lights.push(Light::DiffuseArea(l.invisible()));
+                }
+            }
+            return Ok(());
+        }
         Alpha::Mask(a) => a,
     };
     let (prims, lights) = (&mut sink.prims, &mut sink.lights);
@@ -219,11 +227,11 @@ fn singular(loc: &candela_scene::Loc, what: &str) -> String {
 /// A shape's alpha: a mask (`None` when fully opaque), or `Off` for an
 /// emitter whose constant alpha is 0.
 ///
-/// pbrt-v4 makes a constant-0 emitter an invisible light (typed
-/// `DeltaPosition` so that only light sampling finds it); candela switches
-/// it off instead, since a delta-typed surface light does not fit its
-/// bidirectional integrators. Any other alpha on an emitter masks its
-/// emission too (`DiffuseAreaLight`).
+/// A constant-0 emitter is pbrt-v4's invisible light: never hit, but still
+/// emitting through light and emission sampling (pbrt-v4 types it
+/// `DeltaPosition` to keep it out of MIS; candela marks it not hittable, see
+/// `Light::is_hittable`). Any other alpha on an emitter masks its emission
+/// too (`DiffuseAreaLight`).
 enum Alpha {
     Mask(Option<FloatTexture>),
     Off,
