@@ -99,11 +99,11 @@ Shape "bilinearmesh" "point3 P" [3 -1 -1  3 1 -1  4 -1 1  3 1 1] "point2 uv" [0 
     assert!(si.p().normalize().dot(d) > 1.0 - 1e-6);
 }
 
-/// pbrt-v4 masks an area light's emission with the shape's alpha and skips
-/// alpha-0 surfaces when tracing, so `"float alpha" 0` switches an emitter off
-/// (kroken's lights.pbrt does this); other alpha on an emitter stays an error.
+/// pbrt-v4 skips alpha-0 surfaces when tracing but keeps an emitter with
+/// constant `"float alpha" 0` as an invisible light (kroken's lights.pbrt
+/// does this): it is never hit, yet stays in the light list, not hittable.
 #[test]
-fn emitter_with_alpha_zero_is_switched_off() {
+fn emitter_with_alpha_zero_is_an_invisible_light() {
     let s = setup(
         r#"AttributeBegin
 Translate 5 0 0
@@ -114,7 +114,12 @@ LightSource "point" "rgb I" [1 1 1]
 "#,
     )
     .expect("builds");
-    assert_eq!(s.scene.lights().len(), 1, "only the point light remains");
+    assert_eq!(s.scene.lights().len(), 2, "the invisible light stays");
+    assert_eq!(
+        s.scene.lights().iter().filter(|l| l.is_hittable()).count(),
+        0,
+        "neither the point light nor the invisible one can be hit"
+    );
     assert!(
         s.warnings.iter().all(|w| !w.contains("unused")),
         "{:?}",
