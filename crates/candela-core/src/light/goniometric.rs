@@ -18,9 +18,8 @@
 //! Then p_dir(ω) = Y(ω)/(4π·mean Y) is proportional to I(ω) and
 //! `β₀ = I/p_dir = Φ` for every sample.
 
-use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
+use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::image::{MapImage, WrapMode};
-use crate::interaction::Interaction;
 use crate::math::{Ray, Transform, Vec2, Vec3, PI};
 use crate::sampling::{
     equal_area_sphere_to_square, equal_area_square_to_sphere, Distribution2D, PdfArea,
@@ -87,22 +86,9 @@ impl GoniometricLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let p = self.position();
-        let d2 = p.distance_squared(ctx.p);
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = (p - ctx.p) / d2.sqrt();
-        let wl = self.light_from_render.vector(-wi).normalize();
-        let l = self.intensity(wl, lambda) / d2;
-        if l.is_black() {
-            return None;
-        }
-        Some(LightLiSample {
-            l,
-            wi,
-            pdf: PdfSolidAngle(1.0),
-            p_light: Interaction::at_point(p),
+        let to_light = self.light_from_render;
+        delta_position_li(self.position(), &to_light, ctx, |wl| {
+            self.intensity(wl, lambda)
         })
     }
 

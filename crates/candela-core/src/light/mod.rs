@@ -162,6 +162,33 @@ pub struct LightLeSample {
     pub pdf_dir: PdfSolidAngle,
 }
 
+/// `sample_li` of a light at point `p` (a delta in position: point, spot,
+/// goniometric, projection) whose intensity towards light-frame direction
+/// `wl` is `intensity(wl)` [W/sr]: Li = I(wl)/d² from the receiver, density 1.
+/// `None` at the light itself or where it emits nothing.
+pub(crate) fn delta_position_li(
+    p: Vec3,
+    light_from_render: &crate::math::Transform,
+    ctx: &LightSampleContext,
+    intensity: impl FnOnce(Vec3) -> SampledSpectrum,
+) -> Option<LightLiSample> {
+    let d2 = p.distance_squared(ctx.p);
+    if d2 == 0.0 {
+        return None;
+    }
+    let wi = (p - ctx.p) / d2.sqrt();
+    let l = intensity(light_from_render.vector(-wi).normalize()) / d2;
+    if l.is_black() {
+        return None;
+    }
+    Some(LightLiSample {
+        l,
+        wi,
+        pdf: PdfSolidAngle(1.0),
+        p_light: Interaction::at_point(p),
+    })
+}
+
 impl LightLeSample {
     /// The same emission at path time `time` (motion blur).
     pub fn at_time(mut self, time: f32) -> Self {

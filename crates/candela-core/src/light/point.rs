@@ -6,8 +6,7 @@
 //! sampling draws a uniform direction on the sphere, p_dir = 1/(4π), so
 //! `β₀ = I/(1/(4π)) = Φ` exactly.
 
-use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
-use crate::interaction::Interaction;
+use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::math::{Ray, Transform, Vec2, Vec3, PI};
 use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf, PdfArea, PdfSolidAngle};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -47,17 +46,9 @@ impl PointLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let p = self.position();
-        let d2 = p.distance_squared(ctx.p);
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = (p - ctx.p) / d2.sqrt();
-        Some(LightLiSample {
-            l: self.intensity(lambda) / d2,
-            wi,
-            pdf: PdfSolidAngle(1.0),
-            p_light: Interaction::at_point(p),
+        // Isotropic: the direction in the light's frame does not matter.
+        delta_position_li(self.position(), &Transform::IDENTITY, ctx, |_| {
+            self.intensity(lambda)
         })
     }
 

@@ -38,9 +38,8 @@
 //! pbrt-v4's p_dir = p_screen/(t²·cos³θ) with its piecewise-constant screen
 //! density is replaced by the exact one.
 
-use super::{LightLeSample, LightLiSample, LightSampleContext};
+use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext};
 use crate::image::MapImage;
-use crate::interaction::Interaction;
 use crate::math::{Ray, Transform, Vec2, Vec3};
 use crate::sampling::{Distribution2D, PdfArea, PdfSolidAngle};
 use crate::spectrum::{
@@ -208,22 +207,9 @@ impl ProjectionLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let p = self.position();
-        let d2 = p.distance_squared(ctx.p);
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = (p - ctx.p) / d2.sqrt();
-        let wl = self.light_from_render.vector(-wi).normalize();
-        let l = self.intensity(wl, lambda) / d2;
-        if l.is_black() {
-            return None;
-        }
-        Some(LightLiSample {
-            l,
-            wi,
-            pdf: PdfSolidAngle(1.0),
-            p_light: Interaction::at_point(p),
+        let to_light = self.light_from_render;
+        delta_position_li(self.position(), &to_light, ctx, |wl| {
+            self.intensity(wl, lambda)
         })
     }
 

@@ -14,8 +14,7 @@
 //! uniformly or the band proportionally to the smoothstep; p_dir is therefore
 //! exactly proportional to I(ω), and `β₀ = Φ` for every sample.
 
-use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
-use crate::interaction::Interaction;
+use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::math::{safe_sqrt, spherical_direction, Ray, Transform, Vec2, Vec3, PI};
 use crate::sampling::{sample_uniform_cone, uniform_cone_pdf, PdfArea, PdfSolidAngle};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -120,22 +119,9 @@ impl SpotLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let p = self.position();
-        let d2 = p.distance_squared(ctx.p);
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = (p - ctx.p) / d2.sqrt();
-        let wl = self.render_from_light.inverse().vector(-wi).normalize();
-        let l = self.intensity(wl, lambda) / d2;
-        if l.is_black() {
-            return None;
-        }
-        Some(LightLiSample {
-            l,
-            wi,
-            pdf: PdfSolidAngle(1.0),
-            p_light: Interaction::at_point(p),
+        let to_light = self.render_from_light.inverse();
+        delta_position_li(self.position(), &to_light, ctx, |wl| {
+            self.intensity(wl, lambda)
         })
     }
 
