@@ -207,8 +207,7 @@ impl ProjectionLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let to_light = self.light_from_render;
-        delta_position_li(self.position(), &to_light, ctx, |wl| {
+        delta_position_li(self.position(), &self.light_from_render, ctx, |wl| {
             self.intensity(wl, lambda)
         })
     }
