@@ -133,11 +133,17 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     lights.extend(lights::lights(desc, &mut warnings)?);
     let shutter = entities::shutter(desc)?;
     let mut scene = Scene::with_motion(prims, movers, shutter, materials, lights, power_sampling);
-    scene.set_footprint(Some(PixelFootprint::new(
-        &camera,
-        film.resolution(),
-        sampler.samples_per_pixel(),
-    )));
+    // Only textures read the differentials (filter widths, bump steps), and
+    // every non-constant texture is a `Texture` directive: without any, the
+    // per-hit footprint would cost time (several per cent on the Cornell box)
+    // for nothing.
+    if textures_used.iter().any(|&u| u) {
+        scene.set_footprint(Some(PixelFootprint::new(
+            &camera,
+            film.resolution(),
+            sampler.samples_per_pixel(),
+        )));
+    }
     if let Some(w) = photon_radius_warning(desc, &integrator_name, &scene)? {
         warnings.push(w);
     }
