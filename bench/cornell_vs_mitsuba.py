@@ -5,7 +5,7 @@ on this machine in the same run, and prints the time ratio.
 
     python3 bench/cornell_vs_mitsuba.py [--spp 64] [--threads 2] [--repeats 3]
 
-Needs `pip install mitsuba` (done automatically if missing). Builds the
+Needs `pip install mitsuba numpy` (done automatically if missing). Builds the
 candela binary with `cargo build --release -p candela` if it is not there.
 """
 import argparse, os, re, statistics, subprocess, sys, time
@@ -16,11 +16,13 @@ OUT = os.path.join(ROOT, "bench", "out")
 
 
 def ensure_mitsuba():
-    try:
-        import mitsuba  # noqa: F401
-    except ImportError:
-        print("installing mitsuba from PyPI ...", file=sys.stderr)
-        subprocess.check_call([sys.executable, "-m", "pip", "install", "-q", "mitsuba"])
+    # numpy is needed to read the images back; the mitsuba wheel does not pull it in.
+    for module in ("mitsuba", "numpy"):
+        try:
+            __import__(module)
+        except ImportError:
+            print(f"installing {module} from PyPI ...", file=sys.stderr)
+            subprocess.check_call([sys.executable, "-m", "pip", "install", "-q", module])
     import mitsuba as mi
     return mi
 
