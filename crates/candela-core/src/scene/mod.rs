@@ -159,10 +159,6 @@ impl Scene {
 
     /// Closest hit along `ray` before `t_max`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
-        if self.movers.is_empty() {
-            let (i, hit) = motion::closest_hit(&self.primitives, &self.bvh, ray, t_max)?;
-            return Some(self.finish(i, hit, ray));
-        }
         let n = self.primitives.len() as u32;
         let wr = WatertightRay::new(ray);
         let mut best = None;
@@ -172,14 +168,9 @@ impl Scene {
                 best = Some(Err(si));
                 return Some(t);
             }
-            let prim = &self.primitives[i as usize];
-            let hit = prim.shape.intersect_deferred(ray, &wr, t_max)?;
-            if prim.alpha.is_some() && !prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray) {
-                return None;
-            }
-            let t = hit.t();
+            let hit = self.primitives[i as usize].hit(ray, &wr, t_max)?;
             best = Some(Ok((i, hit)));
-            Some(t)
+            Some(hit.t())
         });
         match best? {
             Ok((i, hit)) => Some(self.finish(i, hit, ray)),
@@ -199,23 +190,13 @@ impl Scene {
 
     /// True if anything blocks `ray` before `t_max`.
     pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
-        if self.movers.is_empty() {
-            return motion::any_hit(&self.primitives, &self.bvh, ray, t_max);
-        }
         let n = self.primitives.len() as u32;
         let wr = WatertightRay::new(ray);
         self.bvh.intersect_p(ray, t_max, |i, ray, t_max| {
             if i >= n {
                 return self.movers[(i - n) as usize].intersect_p(ray, t_max);
             }
-            let prim = &self.primitives[i as usize];
-            if prim.alpha.is_none() {
-                return prim.shape.intersect_p(ray, t_max);
-            }
-            match prim.shape.intersect_deferred(ray, &wr, t_max) {
-                Some(hit) => prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray),
-                None => false,
-            }
+            self.primitives[i as usize].blocks(ray, &wr, t_max)
         })
     }
 

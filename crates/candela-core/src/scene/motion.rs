@@ -132,7 +132,7 @@ fn to_render(m: &Transform, si: &SurfaceInteraction, ray: &Ray) -> SurfaceIntera
 }
 
 /// Closest primitive hit in `prims` (through `bvh`), honouring alpha cut-outs.
-pub(super) fn closest_hit(
+fn closest_hit(
     prims: &[Primitive],
     bvh: &Bvh,
     ray: &Ray,
@@ -141,29 +141,17 @@ pub(super) fn closest_hit(
     let mut best = None;
     let wr = WatertightRay::new(ray);
     bvh.intersect(ray, t_max, |i, ray, t_max| {
-        let prim = &prims[i as usize];
-        let hit = prim.shape.intersect_deferred(ray, &wr, t_max)?;
-        if prim.alpha.is_some() && !prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray) {
-            return None;
-        }
-        let t = hit.t();
+        let hit = prims[i as usize].hit(ray, &wr, t_max)?;
         best = Some((i, hit));
-        Some(t)
+        Some(hit.t())
     });
     best
 }
 
 /// True if any primitive in `prims` blocks the ray, honouring alpha cut-outs.
-pub(super) fn any_hit(prims: &[Primitive], bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
+fn any_hit(prims: &[Primitive], bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
     let wr = WatertightRay::new(ray);
     bvh.intersect_p(ray, t_max, |i, ray, t_max| {
-        let prim = &prims[i as usize];
-        if prim.alpha.is_none() {
-            return prim.shape.intersect_p(ray, t_max);
-        }
-        match prim.shape.intersect_deferred(ray, &wr, t_max) {
-            Some(hit) => prim.alpha_passes(prim.shape.finish_hit(hit, ray).si, ray),
-            None => false,
-        }
+        prims[i as usize].blocks(ray, &wr, t_max)
     })
 }

@@ -17,6 +17,35 @@ pub struct Primitive {
 }
 
 impl Primitive {
+    /// Closest-hit candidate before `t_max` that survives the alpha test.
+    #[inline]
+    pub fn hit(
+        &self,
+        ray: &crate::math::Ray,
+        wr: &crate::shape::WatertightRay,
+        t_max: f32,
+    ) -> Option<crate::shape::DeferredHit> {
+        let hit = self.shape.intersect_deferred(ray, wr, t_max)?;
+        if self.alpha.is_some() && !self.alpha_passes(self.shape.finish_hit(hit, ray).si, ray) {
+            return None;
+        }
+        Some(hit)
+    }
+
+    /// True if the primitive blocks the ray before `t_max` (alpha-tested).
+    #[inline]
+    pub fn blocks(
+        &self,
+        ray: &crate::math::Ray,
+        wr: &crate::shape::WatertightRay,
+        t_max: f32,
+    ) -> bool {
+        if self.alpha.is_none() {
+            return self.shape.intersect_p(ray, t_max);
+        }
+        self.hit(ray, wr, t_max).is_some()
+    }
+
     /// pbrt-v4's alpha test at a candidate hit: kept when α ≥ 1, dropped when
     /// α ≤ 0, otherwise kept with probability α using a hash of the ray (so a
     /// ray and its shadow-ray twin decide alike, and images stay deterministic).
