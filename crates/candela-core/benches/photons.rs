@@ -5,8 +5,8 @@
 
 #![allow(missing_docs)]
 
+use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::integrator::photon::{trace_photon, ShootSettings};
-use candela_core::scene::build::{build, Overrides, RenderSetup};
 use candela_core::spectrum::SampledWavelengths;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rayon::prelude::*;

@@ -6,6 +6,7 @@
 
 pub mod accel;
 pub mod bsdf;
+pub mod build;
 pub mod camera;
 pub mod film;
 pub mod image;

@@ -9,8 +9,8 @@
 
 mod common;
 
+use candela_core::build::Overrides;
 use candela_core::image::RgbImage;
-use candela_core::scene::build::Overrides;
 use common::{render_str, stats};
 
 const K: usize = 8;

@@ -7,7 +7,7 @@
 
 mod common;
 
-use candela_core::scene::build::Overrides;
+use candela_core::build::Overrides;
 use common::{assert_region, render_str};
 
 fn ov(spp: u32) -> Overrides {

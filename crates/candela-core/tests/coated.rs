@@ -11,7 +11,7 @@
 
 mod common;
 
-use candela_core::scene::build::{build, Overrides};
+use candela_core::build::{build, Overrides};
 use common::{assert_region, region_mean, render_str};
 use std::path::Path;
 

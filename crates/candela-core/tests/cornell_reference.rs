@@ -5,9 +5,9 @@
 //! leaves room only for noise in the reference (~1.5 %) — a bias of a few
 //! per cent in any region fails the test.
 
+use candela_core::build::{build, Overrides};
 use candela_core::image::{compare, RgbImage};
 use candela_core::integrator::{NoProgress, RenderContext};
-use candela_core::scene::build::{build, Overrides};
 use std::path::Path;
 
 #[test]

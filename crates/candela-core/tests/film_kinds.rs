@@ -5,7 +5,7 @@
 
 mod common;
 
-use candela_core::scene::build::{build, Overrides};
+use candela_core::build::{build, Overrides};
 use common::render_at;
 use std::path::Path;
 

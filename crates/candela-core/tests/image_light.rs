@@ -10,8 +10,8 @@
 
 mod common;
 
+use candela_core::build::{build, Overrides};
 use candela_core::image::RgbImage;
-use candela_core::scene::build::{build, Overrides};
 use common::{assert_region, region_mean, render_at};
 use std::path::{Path, PathBuf};
 

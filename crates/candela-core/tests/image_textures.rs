@@ -9,7 +9,7 @@
 
 mod common;
 
-use candela_core::scene::build::Overrides;
+use candela_core::build::Overrides;
 use common::{assert_region, render_at};
 use std::path::{Path, PathBuf};
 

@@ -12,7 +12,7 @@
 
 mod common;
 
-use candela_core::scene::build::{build, Overrides};
+use candela_core::build::{build, Overrides};
 use common::render_str;
 use std::path::Path;
 

@@ -10,7 +10,7 @@
 
 mod common;
 
-use candela_core::scene::build::Overrides;
+use candela_core::build::Overrides;
 use common::{assert_region, render_at};
 use std::path::PathBuf;
 
@@ -92,7 +92,7 @@ fn a_missing_or_grey_normal_map_is_a_located_error() {
     let build = |material: &str| {
         let desc =
             candela_scene::parse_str(&scene(material), &dir.join("scene.pbrt")).expect("parses");
-        candela_core::scene::build::build(&desc, &Overrides::default())
+        candela_core::build::build(&desc, &Overrides::default())
             .err()
             .map(|e| e.to_string())
     };

@@ -9,9 +9,9 @@
 
 mod common;
 
+use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::image::RgbImage;
 use candela_core::integrator::{NoProgress, RenderContext};
-use candela_core::scene::build::{build, Overrides, RenderSetup};
 use common::stats;
 use std::path::PathBuf;
 

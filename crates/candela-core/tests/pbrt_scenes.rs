@@ -18,8 +18,8 @@
 
 mod common;
 
+use candela_core::build::Overrides;
 use candela_core::image::RgbImage;
-use candela_core::scene::build::Overrides;
 use common::render_at;
 use std::path::{Path, PathBuf};
 

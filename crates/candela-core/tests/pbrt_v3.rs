@@ -2,7 +2,7 @@
 //! `--upgrade` rewrite builds to, with one warning per converted directive
 //! (naming `file:line:col`) and no unused-parameter warnings.
 
-use candela_core::scene::build::{build, Overrides, RenderSetup};
+use candela_core::build::{build, Overrides, RenderSetup};
 use std::path::{Path, PathBuf};
 
 const HEADER: &str = "Film \"rgb\" \"integer xresolution\" [4] \"integer yresolution\" [4]

@@ -6,8 +6,8 @@
 //! Statistical checks use |x − expected| ≤ 5σ with σ derived from the
 //! binomial or measured per-photon variance.
 
+use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::integrator::photon::{trace_photon, ShootSettings};
-use candela_core::scene::build::{build, Overrides, RenderSetup};
 use candela_core::spectrum::SampledWavelengths;
 use rayon::prelude::*;
 use std::path::Path;

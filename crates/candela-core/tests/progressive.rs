@@ -13,10 +13,10 @@
 
 mod common;
 
+use candela_core::build::{build, Overrides};
 use candela_core::integrator::photon::{trace_photon, ShootSettings};
 use candela_core::integrator::sppm::ppm_radius2;
 use candela_core::integrator::{NoProgress, PpmIntegrator, PpmSettings, RenderContext};
-use candela_core::scene::build::{build, Overrides};
 use candela_core::spectrum::SampledWavelengths;
 use common::render_str;
 use rayon::prelude::*;

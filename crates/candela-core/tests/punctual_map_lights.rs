@@ -24,8 +24,8 @@
 
 mod common;
 
+use candela_core::build::{build, Overrides};
 use candela_core::image::RgbImage;
-use candela_core::scene::build::{build, Overrides};
 use common::{render_at, stats};
 use std::path::{Path, PathBuf};
 

@@ -9,8 +9,8 @@
 
 mod common;
 
+use candela_core::build::{build, Overrides};
 use candela_core::image::RgbImage;
-use candela_core::scene::build::{build, Overrides};
 use candela_core::spectrum::daylight;
 use common::{region_mean, render_str};
 use std::path::Path;

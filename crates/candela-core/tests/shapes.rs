@@ -5,8 +5,8 @@
 
 mod common;
 
+use candela_core::build::{build, BuildError, Overrides, RenderSetup};
 use candela_core::math::{Ray, Vec3};
-use candela_core::scene::build::{build, BuildError, Overrides, RenderSetup};
 use common::{assert_region, render_str};
 use std::path::Path;
 

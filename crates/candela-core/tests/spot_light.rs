@@ -2,9 +2,9 @@
 //! (`coneangle` 30° and `conedeltaangle` 5° by default). The intensity is full
 //! inside coneangle − conedeltaangle and smooth-steps to zero at coneangle.
 
+use candela_core::build::{build, Overrides};
 use candela_core::light::LightSampleContext;
 use candela_core::math::{Vec2, Vec3};
-use candela_core::scene::build::{build, Overrides};
 use candela_core::spectrum::SampledWavelengths;
 use std::path::Path;
 

@@ -10,7 +10,7 @@
 
 mod common;
 
-use candela_core::scene::build::{build, Overrides};
+use candela_core::build::{build, Overrides};
 use common::{assert_region, render_str};
 use std::path::Path;
 

@@ -4,10 +4,10 @@
 mod progress;
 
 use anyhow::{bail, Context, Result};
+use candela_core::build::{build, summarize, Overrides};
 use candela_core::image::{compare, RgbImage};
 use candela_core::integrator::sppm::PpmPartial;
 use candela_core::integrator::RenderContext;
-use candela_core::scene::build::{build, summarize, Overrides};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

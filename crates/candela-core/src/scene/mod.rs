@@ -1,7 +1,6 @@
 //! The traceable scene: primitives in a BVH, materials, lights and the
 //! light sampler. Built from a plain description by [`build`].
 
-pub mod build;
 mod motion;
 mod primitive;
 

@@ -6,9 +6,9 @@
 
 pub mod stats;
 
+use candela_core::build::{build, Overrides};
 use candela_core::image::RgbImage;
 use candela_core::integrator::{NoProgress, RenderContext};
-use candela_core::scene::build::{build, Overrides};
 use std::path::Path;
 
 /// Renders pbrt-v4 scene text with the given overrides; asserts no sample was dropped.

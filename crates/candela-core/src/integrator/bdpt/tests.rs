@@ -14,10 +14,10 @@ use super::mis::{strategy_valid, weight_from_densities, MisHeuristic, PathDensit
 use super::vertex::{pdf, pdf_light_origin, Vertex, VertexKind};
 use super::walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
 use crate::bsdf::TransportMode;
+use crate::build::{build, Overrides, RenderSetup};
 use crate::camera::CameraSample;
 use crate::math::{UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
-use crate::scene::build::{build, Overrides, RenderSetup};
 use crate::spectrum::SampledWavelengths;
 use std::path::Path;
 
