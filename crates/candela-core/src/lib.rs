@@ -15,6 +15,7 @@ pub mod interaction;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod render;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;

@@ -8,7 +8,7 @@
 mod common;
 
 use candela_core::build::Overrides;
-use common::{assert_region, render_str};
+use common::{assert_region, render_developed, render_str};
 
 fn ov(spp: u32) -> Overrides {
     Overrides {
@@ -259,21 +259,23 @@ fn t7_each_bdpt_strategy_alone_renders_the_emitter_radiance() {
     // camera hitting the emitter (s = 0, t = 2) and the light point splatted
     // to the lens (s = 1, t = 1) are two complete estimators of L = 2.
     // visualizeweights writes weighted estimates, which sum to the image.
-    let dir = std::env::temp_dir().join(format!("candela-vis-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    // The strategy images are layers of the film, written as
+    // bdpt_dDD_sSS_tTT.exr beside the image; here they are read from the film.
     for (flag, weighted) in [("visualizestrategies", false), ("visualizeweights", true)] {
         let scene = emitter_scene("bdpt").replace(
             "Integrator \"bdpt\" \"integer maxdepth\" [5]",
             &format!("Integrator \"bdpt\" \"integer maxdepth\" [1] \"bool {flag}\" true"),
         );
         assert!(scene.contains(flag));
-        let ov = Overrides {
-            outfile: Some(dir.join("main.exr")),
-            ..bdpt(512)
-        };
-        let main = render_str(&scene, &ov);
+        let dev = render_developed(&scene, &bdpt(512));
+        let main = dev.rgb();
+        let names = candela_core::integrator::Visualize::file_names(1);
         let read = |name: &str| {
-            candela_core::image::RgbImage::read_exr(&dir.join(name)).expect("strategy image")
+            let k = names
+                .iter()
+                .position(|n| n.as_deref() == Some(name))
+                .expect("strategy image");
+            dev.strategies[k].clone()
         };
         let (a, b) = (read("bdpt_d00_s00_t02.exr"), read("bdpt_d00_s01_t01.exr"));
         if weighted {
@@ -292,7 +294,6 @@ fn t7_each_bdpt_strategy_alone_renders_the_emitter_radiance() {
             assert_region(&b, (1, 23, 1, 15), 2.0, 2e-3 * 2.0, "T7 s=1 t=1 alone");
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

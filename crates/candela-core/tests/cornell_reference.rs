@@ -7,7 +7,6 @@
 
 use candela_core::build::{build, Overrides};
 use candela_core::image::{compare, RgbImage};
-use candela_core::integrator::{NoProgress, RenderContext};
 use std::path::Path;
 
 #[test]
@@ -19,16 +18,10 @@ fn cornell_box_matches_pbrt_v4_reference() {
         seed: Some(7),
         ..Default::default()
     };
-    let mut setup = build(&desc, &ov).expect("scene builds");
-    let ctx = RenderContext {
-        scene: &setup.scene,
-        camera: &setup.camera,
-        sampler: &setup.sampler,
-        progress: &NoProgress,
-    };
-    setup.integrator.render(&ctx, &mut setup.film);
-    assert_eq!(setup.film.dropped_samples(), 0, "non-finite samples");
-    let img = setup.film.image();
+    let setup = build(&desc, &ov).expect("scene builds");
+    let (dev, state) = candela_core::render::render_all(&setup);
+    assert_eq!(state.film.dropped(), 0, "non-finite samples");
+    let img = dev.rgb();
     let reference =
         RgbImage::read_exr(&root.join("reference-pbrt-v4-path-1024spp.exr")).expect("reference");
     let c = compare(&img, &reference).expect("same size");

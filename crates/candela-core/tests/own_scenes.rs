@@ -11,7 +11,6 @@ mod common;
 
 use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::image::RgbImage;
-use candela_core::integrator::{NoProgress, RenderContext};
 use common::stats;
 use std::path::PathBuf;
 
@@ -42,22 +41,15 @@ fn setup_text(name: &str, text: &str) -> RenderSetup {
 }
 
 /// One render with `seed`; checks no sample was dropped and every pixel is finite.
-fn render(s: &RenderSetup, seed: u64, name: &str) -> RgbImage {
-    let sampler = s.sampler.clone_with_seed(seed);
-    let mut film = s.film.cleared();
-    let ctx = RenderContext {
-        scene: &s.scene,
-        camera: &s.camera,
-        sampler: &sampler,
-        progress: &NoProgress,
-    };
-    s.integrator.render(&ctx, &mut film);
+fn render(s: &mut RenderSetup, seed: u64, name: &str) -> RgbImage {
+    s.sampler = s.sampler.clone_with_seed(seed);
+    let (dev, state) = candela_core::render::render_all(s);
     assert_eq!(
-        film.dropped_samples(),
+        state.film.dropped(),
         0,
         "{name}, seed {seed}: non-finite samples"
     );
-    let img = film.image();
+    let img = dev.rgb();
     assert!(
         img.pixels.iter().flatten().all(|v| v.is_finite()),
         "{name}, seed {seed}: non-finite pixel"
@@ -66,7 +58,7 @@ fn render(s: &RenderSetup, seed: u64, name: &str) -> RgbImage {
 }
 
 /// Block means of K renders with seeds `first..first + K`, `[block][render]`.
-fn blocks(s: &RenderSetup, first: u64, name: &str) -> Vec<Vec<f64>> {
+fn blocks(s: &mut RenderSetup, first: u64, name: &str) -> Vec<Vec<f64>> {
     let renders: Vec<Vec<f64>> = (first..first + K as u64)
         .map(|seed| stats::block_means(&render(s, seed, name)))
         .collect();
@@ -76,13 +68,13 @@ fn blocks(s: &RenderSetup, first: u64, name: &str) -> Vec<Vec<f64>> {
 /// Builds `name` (checking its size and that it is warning-free), renders
 /// two independent sets of seeds and compares them.
 fn check(name: &str) -> RenderSetup {
-    let s = setup(name);
+    let mut s = setup(name);
     let res = s.film.resolution();
     assert!(res.x <= 128 && res.y <= 128, "{name}: {res} is not small");
     if name != "pbrt-v3-materials" {
         assert!(s.warnings.is_empty(), "{name}: {:#?}", s.warnings);
     }
-    let (a, b) = (blocks(&s, 1, name), blocks(&s, 1001, name));
+    let (a, b) = (blocks(&mut s, 1, name), blocks(&mut s, 1001, name));
     assert_eq!(a.len(), (res.x as usize / 8) * (res.y as usize / 8));
     stats::assert_blocks_agree(&a, &b, name);
     s
@@ -138,7 +130,7 @@ fn the_comparison_sees_a_four_per_cent_brighter_sky() {
     let text = std::fs::read_to_string(scene_path(name)).expect("scene");
     let brighter = text.replace("\"rgb L\" [0.9 0.95 1.0]", "\"rgb L\" [0.936 0.988 1.04]");
     assert_ne!(text, brighter);
-    let (a, b) = (setup(name), setup_text(name, &brighter));
-    let d = stats::disagreement(&blocks(&a, 1, name), &blocks(&b, 1001, name));
+    let (mut a, mut b) = (setup(name), setup_text(name, &brighter));
+    let d = stats::disagreement(&blocks(&mut a, 1, name), &blocks(&mut b, 1001, name));
     assert!(d.is_some(), "a 4% brighter sky went unnoticed");
 }

@@ -16,11 +16,12 @@ mod common;
 use candela_core::build::{build, Overrides};
 use candela_core::integrator::photon::{trace_photon, ShootSettings};
 use candela_core::integrator::sppm::ppm_radius2;
-use candela_core::integrator::{NoProgress, PpmIntegrator, PpmSettings, RenderContext};
+use candela_core::render::{self, RenderOptions};
 use candela_core::spectrum::SampledWavelengths;
 use common::render_str;
 use rayon::prelude::*;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 
 #[test]
 fn t1_ppm_mean_after_100_passes_equals_its_biased_expectation() {
@@ -123,36 +124,42 @@ fn t4b_sppm_and_ppm_have_no_kernel_bias_in_the_sphere_furnace() {
 
 #[test]
 fn ppm_partial_renders_merge_into_the_full_render_bit_for_bit() {
-    let desc = candela_scene::parse_str(&furnace("ppm", 0.3), Path::new("f.pbrt")).expect("parses");
-    let run = |range: (u64, u64)| {
-        let setup = build(&desc, &Overrides::default()).expect("builds");
-        let ctx = RenderContext {
-            scene: &setup.scene,
-            camera: &setup.camera,
-            sampler: &setup.sampler,
-            progress: &NoProgress,
-        };
-        let ppm = PpmIntegrator {
-            settings: PpmSettings {
-                photons_per_pass: 2000,
-                radius: 0.3,
-                max_depth: 20,
-                seed: 4,
-                pass_range: Some(range),
-                partial_out: None,
-            },
-        };
-        let partial = ppm.render_partial(&ctx, &setup.film);
-        (partial, setup.film.cleared())
+    let text = furnace("ppm", 0.3).replace(
+        "\"integer maxdepth\"",
+        "\"integer seed\" [4] \"integer maxdepth\"",
+    );
+    let desc = candela_scene::parse_str(&text, Path::new("f.pbrt")).expect("parses");
+    let ov = Overrides {
+        spp: Some(6),
+        ..Default::default()
     };
-    let (full, mut film_full) = run((0, 6));
-    let (mut first, _) = run((0, 2));
-    let (second, mut film_merged) = run((2, 6));
-    first.merge(&second).expect("disjoint");
+    let setup = build(&desc, &ov).expect("builds");
+    let run = |range: (u64, u64)| {
+        let mut state = render::new_state(&setup, 1, 6, "");
+        let opts = RenderOptions {
+            passes: range,
+            ..Default::default()
+        };
+        let stop = AtomicBool::new(false);
+        render::render(
+            &setup,
+            &mut state,
+            &opts,
+            &stop,
+            &render::NoProgress,
+            &mut |_| {},
+        )
+        .expect("renders");
+        state
+    };
+    let full = run((0, 6));
+    let mut first = run((0, 2));
+    first.merge(&run((2, 6))).expect("disjoint");
     assert_eq!(first, full, "fixed-point sums add associatively");
-    full.write_film(&mut film_full);
-    first.write_film(&mut film_merged);
-    assert_eq!(film_full.image(), film_merged.image());
+    assert_eq!(
+        render::develop_state(&setup, &first),
+        render::develop_state(&setup, &full)
+    );
 }
 
 /// The gather radius is checked against the scene's scale: in the unit-sphere

@@ -116,6 +116,14 @@ impl Builder {
         }
     }
 
+    /// Records a scene file that was read.
+    pub(crate) fn add_source(&mut self, path: &Path, bytes: &[u8]) {
+        self.desc.sources.push(crate::desc::SourceFile {
+            path: path.to_path_buf(),
+            hash: crate::desc::fnv1a64(bytes),
+        });
+    }
+
     /// Records a warning.
     pub(crate) fn warn(&mut self, loc: &Loc, message: impl Into<String>) {
         self.desc.warnings.push(Warning {

@@ -197,4 +197,28 @@ pub struct SceneDescription {
     pub warnings: Vec<Warning>,
     /// The main scene file's directory; relative file names resolve here.
     pub base_dir: PathBuf,
+    /// The scene files read, main file first, then every `Include`/`Import`
+    /// in reading order, each with a hash of its bytes (for checkpoints and
+    /// partial renders, which must come from the same scene, and for packing
+    /// a scene with its files).
+    pub sources: Vec<SourceFile>,
+}
+
+/// A scene file that was read and the FNV-1a hash of its (decompressed) bytes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SourceFile {
+    /// The path as resolved when it was read.
+    pub path: PathBuf,
+    /// FNV-1a 64 of its bytes.
+    pub hash: u64,
+}
+
+/// FNV-1a 64-bit hash of `bytes` [Fowler, Noll, Vo].
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
 }

@@ -31,8 +31,8 @@ mod world;
 use std::path::Path;
 
 pub use desc::{
-    CameraDesc, Entity, InstanceDefinition, InstanceUse, LightDesc, MaterialDesc, MaterialRef,
-    SceneDescription, ShapeDesc, TextureDesc, TextureKind,
+    fnv1a64, CameraDesc, Entity, InstanceDefinition, InstanceUse, LightDesc, MaterialDesc,
+    MaterialRef, SceneDescription, ShapeDesc, SourceFile, TextureDesc, TextureKind,
 };
 pub use error::{Loc, SceneError, Warning};
 pub use math::Mat4d;

@@ -59,6 +59,8 @@ pub(crate) fn read_scene_file(path: &Path, loc: &Loc) -> Result<Vec<u8>> {
 pub(crate) fn parse_bytes(text: Vec<u8>, path: &Path) -> Result<SceneDescription> {
     let base_dir: Arc<Path> = Arc::from(path.parent().unwrap_or(Path::new("")));
     let file: Arc<Path> = Arc::from(path);
+    let mut b = Builder::new(&base_dir);
+    b.add_source(path, &text);
     let lexer = Lexer::new(text, file);
     let mut p = Parser {
         files: vec![Source {
@@ -66,7 +68,7 @@ pub(crate) fn parse_bytes(text: Vec<u8>, path: &Path) -> Result<SceneDescription
             key: canonical(path),
             import: false,
         }],
-        b: Builder::new(&base_dir),
+        b,
         base_dir,
         end: Loc::file_only(path),
     };
@@ -461,6 +463,7 @@ impl Parser {
             ));
         }
         let text = read_scene_file(&path, loc)?;
+        self.b.add_source(&path, &text);
         if import {
             self.b.push(Block::Import, loc);
         }

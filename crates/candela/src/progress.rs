@@ -1,44 +1,116 @@
-//! A progress bar with ETA on stderr (indicatif), hidden by `--quiet`.
+//! Render progress on stderr: a bar with rate and ETA on a terminal
+//! (indicatif), plain lines every ten seconds otherwise (CI logs, pipes),
+//! nothing with `--quiet`.
 
-use candela_core::integrator::Progress;
+use candela_core::render::{Progress, Snapshot};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
-/// The render progress bar.
-pub struct Bar {
-    bar: ProgressBar,
+/// How progress is shown.
+pub enum Display {
+    /// A bar on a terminal.
+    Bar(ProgressBar),
+    /// A line every `every`.
+    Lines {
+        /// When the last line was printed.
+        last: Mutex<Option<Instant>>,
+        /// Period.
+        every: Duration,
+    },
+    /// Nothing.
+    Quiet,
 }
 
-impl Bar {
-    /// A bar drawing to stderr, or a hidden one.
-    pub fn new(quiet: bool) -> Self {
-        let bar = ProgressBar::with_draw_target(
-            None,
-            if quiet {
-                ProgressDrawTarget::hidden()
-            } else {
-                ProgressDrawTarget::stderr()
-            },
-        );
-        Self { bar }
-    }
-}
-
-impl Progress for Bar {
-    fn start(&self, total: u64, unit: &str) {
-        self.bar.set_length(total);
-        let style = ProgressStyle::with_template(&format!(
-            "{{elapsed_precise}} [{{bar:40}}] {{percent:>3}}% {{pos}}/{{len}} {unit} ETA {{eta}} {{msg}}"
-        ))
+/// Picks the display for stderr.
+pub fn display(quiet: bool) -> Display {
+    if quiet {
+        Display::Quiet
+    } else if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        let style = ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {percent:>3}% ETA {eta} {msg}",
+        )
         .unwrap_or_else(|_| ProgressStyle::default_bar());
-        self.bar.set_style(style);
+        bar.set_style(style);
+        Display::Bar(bar)
+    } else {
+        Display::Lines {
+            last: Mutex::new(None),
+            every: Duration::from_secs(10),
+        }
     }
-    fn advance(&self, done: u64) {
-        self.bar.inc(done);
+}
+
+/// "pass 12/64, 1.25 M samples/s, status".
+fn describe(s: &Snapshot) -> String {
+    let passes_this_run = s.passes_done - s.passes_at_start;
+    let work = passes_this_run * s.work_per_pass + s.work_in_pass;
+    let secs = s.elapsed.as_secs_f64();
+    let rate = if secs > 0.0 { work as f64 / secs } else { 0.0 };
+    let mut msg = format!(
+        "pass {}/{}, {:.3} M {}/s",
+        s.passes_done,
+        s.passes_goal,
+        rate / 1e6,
+        s.unit
+    );
+    if let Some(st) = &s.status {
+        msg.push_str(", ");
+        msg.push_str(st);
     }
-    fn finish(&self) {
-        self.bar.finish_and_clear();
+    msg
+}
+
+/// Work units done and planned in this run.
+fn position(s: &Snapshot) -> (u64, u64) {
+    let run = s.passes_goal - s.passes_at_start;
+    let done = (s.passes_done - s.passes_at_start) * s.work_per_pass + s.work_in_pass;
+    let total = run * s.work_per_pass;
+    (done.min(total), total)
+}
+
+impl Progress for Display {
+    fn update(&self, s: &Snapshot) {
+        match self {
+            Display::Bar(bar) => {
+                let (pos, len) = position(s);
+                bar.set_length(len.max(1));
+                bar.set_position(pos);
+                bar.set_message(describe(s));
+            }
+            Display::Lines { last, every } => {
+                let Ok(mut last) = last.lock() else { return };
+                if last.is_some_and(|t| t.elapsed() < *every) {
+                    return;
+                }
+                *last = Some(Instant::now());
+                let (pos, len) = position(s);
+                let pct = if len > 0 {
+                    100.0 * pos as f64 / len as f64
+                } else {
+                    100.0
+                };
+                let eta = if pos > 0 {
+                    let secs = s.elapsed.as_secs_f64() * (len - pos) as f64 / pos as f64;
+                    format!("{secs:.0} s")
+                } else {
+                    "?".to_string()
+                };
+                eprintln!(
+                    "candela: {:.0} s, {pct:.0}%, ETA {eta}: {}",
+                    s.elapsed.as_secs_f64(),
+                    describe(s)
+                );
+            }
+            Display::Quiet => {}
+        }
     }
-    fn message(&self, msg: &str) {
-        self.bar.set_message(msg.to_string());
+
+    fn finish(&self, _s: &Snapshot) {
+        if let Display::Bar(bar) = self {
+            bar.finish_and_clear();
+        }
     }
 }

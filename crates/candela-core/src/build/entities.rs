@@ -3,13 +3,7 @@
 use super::{BuildError, Overrides};
 use crate::camera::{Camera, CameraParams, SphericalCamera, SphericalMapping};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
-use crate::film::{FilmSettings, RgbFilm};
-use crate::integrator::photonmap::Kernel;
-use crate::integrator::{
-    BdptIntegrator, BdptSettings, Integrator, LightTracer, PathIntegrator, PathSettings,
-    PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator, PpmSettings, SppmIntegrator,
-    SppmSettings, Visualize,
-};
+use crate::film::{Film, FilmSettings};
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::spectrum::{ColorSpace, PixelSensor};
@@ -29,7 +23,7 @@ pub fn film(
     desc: &SceneDescription,
     ov: &Overrides,
     warnings: &mut Vec<String>,
-) -> Result<(RgbFilm, PathBuf), BuildError> {
+) -> Result<(Film, PathBuf), BuildError> {
     let empty = super::default_entity("rgb");
     let e = desc.film.as_ref().unwrap_or(&empty);
     let p = &e.params;
@@ -95,7 +89,7 @@ pub fn film(
         max_component_value,
     };
     Ok((
-        RgbFilm::new(settings, filter, sensor, output_from_sensor),
+        Film::new(settings, filter, sensor, output_from_sensor),
         outfile,
     ))
 }
@@ -198,7 +192,7 @@ fn filter(desc: &SceneDescription) -> Result<Filter, BuildError> {
 }
 
 /// The camera.
-pub fn camera(desc: &SceneDescription, film: &RgbFilm) -> Result<Camera, BuildError> {
+pub fn camera(desc: &SceneDescription, film: &Film) -> Result<Camera, BuildError> {
     let Some(c) = &desc.camera else {
         let params = CameraParams::new(Transform::IDENTITY, film.resolution());
         return Camera::perspective(&params).map_err(|e| BuildError::Other(e.to_string()));
@@ -288,173 +282,4 @@ pub fn sampler(
         ));
     }
     Ok(Sampler::new(kind, spp, seed))
-}
-
-/// The integrator; returns it, its name and whether lights are sampled by power.
-pub fn integrator(
-    desc: &SceneDescription,
-    ov: &Overrides,
-    outfile: &std::path::Path,
-    warnings: &mut Vec<String>,
-) -> Result<(Box<dyn Integrator>, String, bool), BuildError> {
-    let empty = super::default_entity("volpath");
-    let e = desc.integrator.as_ref().unwrap_or(&empty);
-    let name = ov.integrator.clone().unwrap_or_else(|| e.name.clone());
-    let p = &e.params;
-    let max_depth = p.get_int("maxdepth", 5)?.max(0) as u32;
-    let regularize = p.get_bool("regularize", false)?;
-    let power = match p.get_string("lightsampler", "bvh")?.as_str() {
-        "uniform" => false,
-        "power" | "bvh" => true,
-        other => {
-            return Err(BuildError::at(
-                &e.loc,
-                format!("unknown light sampler \"{other}\""),
-            ))
-        }
-    };
-    match name.as_str() {
-        "lightpath" => {
-            let seed = render_seed(desc, ov)?;
-            return Ok((Box::new(LightTracer { max_depth, seed }), name, power));
-        }
-        "photonmap" => {
-            if !power {
-                warnings.push(format!(
-                    "{}: \"photonmap\" always chooses lights by power; \"lightsampler\" is ignored",
-                    e.loc
-                ));
-            }
-            let settings = photonmap_settings(p, max_depth, render_seed(desc, ov)?, &e.loc)?;
-            let pm = PhotonMapIntegrator { settings };
-            return Ok((Box::new(pm), name, true));
-        }
-        "bdpt" => {
-            let strategies = p.get_bool("visualizestrategies", false)?;
-            let weights = p.get_bool("visualizeweights", false)?;
-            let visualize = (strategies || weights).then(|| Visualize {
-                weighted: weights,
-                dir: outfile
-                    .parent()
-                    .map(|d| d.to_path_buf())
-                    .unwrap_or_default(),
-            });
-            let settings = BdptSettings {
-                max_depth,
-                regularize,
-                visualize,
-                ..BdptSettings::default()
-            };
-            return Ok((Box::new(BdptIntegrator { settings }), name, power));
-        }
-        "sppm" | "ppm" => {
-            let seed = match (ov.seed, &desc.sampler) {
-                (Some(s), _) => s,
-                (None, _) => p.get_int("seed", 0)? as u64,
-            };
-            let photons = p.get_int("photonsperiteration", -1)? as i64;
-            let radius = p.get_float("radius", 1.0)?;
-            if radius.is_nan() || radius <= 0.0 {
-                return Err(BuildError::at(
-                    p.param_loc("radius").unwrap_or(&e.loc),
-                    format!("\"radius\" must be positive, found {radius}"),
-                ));
-            }
-            // Photons are shot by power, as pbrt-v4's SPPM does.
-            if name == "sppm" {
-                if ov.pass_range.is_some() {
-                    return Err(BuildError::Other(
-                        "--pass-range needs Integrator \"ppm\" (SPPM passes are not independent)".into(),
-                    ));
-                }
-                let settings = SppmSettings {
-                    photons_per_iteration: photons,
-                    radius,
-                    max_depth,
-                    seed,
-                };
-                return Ok((Box::new(SppmIntegrator { settings }), name, true));
-            }
-            let partial_out = ov.pass_range.map(|_| outfile.with_extension("ppmpart"));
-            let settings = PpmSettings {
-                photons_per_pass: photons,
-                radius,
-                max_depth,
-                seed,
-                pass_range: ov.pass_range,
-                partial_out,
-            };
-            return Ok((Box::new(PpmIntegrator { settings }), name, true));
-        }
-        "path" => {}
-        "volpath" => warnings.push(format!(
-            "{}: integrator \"volpath\" rendered with \"path\" (participating media are not supported yet; identical without media)",
-            e.loc
-        )),
-        other => {
-            return Err(BuildError::at(&e.loc, format!("integrator \"{other}\" is not supported yet (supported: path, volpath, lightpath, bdpt, sppm, ppm, photonmap)")));
-        }
-    }
-    let settings = PathSettings {
-        max_depth,
-        regularize,
-    };
-    Ok((Box::new(PathIntegrator { settings }), name, power))
-}
-
-/// The seed of integrators that draw their own random numbers (`--seed`,
-/// else the sampler's `seed`).
-fn render_seed(desc: &SceneDescription, ov: &Overrides) -> Result<u64, BuildError> {
-    Ok(match (ov.seed, &desc.sampler) {
-        (Some(s), _) => s,
-        (None, Some(e)) => e.params.get_int("seed", 0)? as u64,
-        (None, None) => 0,
-    })
-}
-
-/// `Integrator "photonmap"` parameters (table in `integrator::photonmap`).
-fn photonmap_settings(
-    p: &candela_scene::ParamSet,
-    max_depth: u32,
-    seed: u64,
-    loc: &candela_scene::Loc,
-) -> Result<PhotonMapSettings, BuildError> {
-    let d = PhotonMapSettings::default();
-    let count = |name: &str, def: u64| -> Result<u64, BuildError> {
-        Ok(p.get_int(name, def as i32)?.max(0) as u64)
-    };
-    let kernel = match p.get_string("kernel", "cone")?.as_str() {
-        "cone" => match p.get_float("conek", 1.1)? {
-            k if k >= 1.0 => Kernel::Cone(k),
-            _ => return Err(BuildError::at(loc, "\"conek\" must be at least 1")),
-        },
-        "epanechnikov" => Kernel::Epanechnikov,
-        "disk" => Kernel::Disk,
-        other => {
-            return Err(BuildError::at(
-                loc,
-                format!("unknown kernel \"{other}\" (known: cone, epanechnikov, disk)"),
-            ))
-        }
-    };
-    let radius = |name: &str| match p.get_floats(name)? {
-        None => Ok(None),
-        Some(v) if v.len() == 1 && v[0] > 0.0 => Ok(Some(v[0])),
-        Some(_) => Err(BuildError::at(
-            loc,
-            format!("\"{name}\" must be one positive float"),
-        )),
-    };
-    Ok(PhotonMapSettings {
-        max_depth,
-        photons: count("photons", d.photons)?,
-        caustic_photons: count("causticphotons", d.caustic_photons)?,
-        lookup: count("lookup", d.lookup as u64)?.max(2) as usize,
-        max_radius: radius("maxradius")?,
-        caustic_max_radius: radius("causticmaxradius")?,
-        kernel,
-        final_gather: p.get_bool("finalgather", d.final_gather)?,
-        gather_rays: count("gatherrays", d.gather_rays as u64)? as u32,
-        seed,
-    })
 }

@@ -152,28 +152,9 @@ fn add_shape(
             .end
             .unwrap_or(parent.start)
             .then_after(&object_end.unwrap_or(object));
-        if let Some(a) = &s.area_light {
-            return Err(BuildError::at(
-                &a.loc,
-                "an area light on a moving shape is not supported (pbrt-v4 does not animate area lights either)",
-            ));
-        }
-        let Alpha::Mask(alpha) = alpha else {
-            return Ok(()); // Switched off (only emitters, refused above).
-        };
-        let prims = build_shape(s, &Transform::IDENTITY)?
-            .into_iter()
-            .map(|shape| Primitive {
-                shape,
-                material,
-                area_light: None,
-                alpha: alpha.clone(),
-            })
-            .collect();
-        let [t0, t1] = parent.times;
-        let motion = AnimatedTransform::new(render_from_object, t0, end, t1);
-        sink.movers.push(MovingGroup::new(prims, motion));
-        return Ok(());
+        let motion =
+            AnimatedTransform::new(render_from_object, parent.times[0], end, parent.times[1]);
+        return add_moving_shape(s, material, alpha, motion, sink);
     }
     let shapes = build_shape(s, &render_from_object)?;
     let spec = s
@@ -214,6 +195,37 @@ fn add_shape(
             alpha: alpha.clone(),
         });
     }
+    Ok(())
+}
+
+/// A shape whose transform changes over the shutter: its primitives in
+/// object space in a [`MovingGroup`] that `motion` places.
+fn add_moving_shape(
+    s: &ShapeDesc,
+    material: Option<MaterialId>,
+    alpha: Alpha,
+    motion: AnimatedTransform,
+    sink: &mut Sink,
+) -> Result<(), BuildError> {
+    if let Some(a) = &s.area_light {
+        return Err(BuildError::at(
+            &a.loc,
+            "an area light on a moving shape is not supported (pbrt-v4 does not animate area lights either)",
+        ));
+    }
+    let Alpha::Mask(alpha) = alpha else {
+        return Ok(()); // Switched off (only emitters, refused above).
+    };
+    let prims = build_shape(s, &Transform::IDENTITY)?
+        .into_iter()
+        .map(|shape| Primitive {
+            shape,
+            material,
+            area_light: None,
+            alpha: alpha.clone(),
+        })
+        .collect();
+    sink.movers.push(MovingGroup::new(prims, motion));
     Ok(())
 }
 

@@ -9,6 +9,7 @@ mod coated;
 mod entities;
 mod geometry;
 mod image_textures;
+mod integrators;
 mod lights;
 mod materials;
 mod shapes;
@@ -16,11 +17,12 @@ mod spectra;
 mod summary;
 mod textures;
 
+pub use integrators::{kind_from_name, INTEGRATOR_NAMES};
 pub use summary::{summarize, Counts, SceneSummary};
 
 use crate::camera::{Camera, PixelFootprint};
-use crate::film::RgbFilm;
-use crate::integrator::Integrator;
+use crate::film::{Film, FilmKind, FilmLayout, SurfaceSpace};
+use crate::integrator::{Integrator, IntegratorKind};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription, SceneError};
@@ -77,8 +79,6 @@ pub struct Overrides {
     pub outfile: Option<PathBuf>,
     /// `--seed`.
     pub seed: Option<u64>,
-    /// `--pass-range A..B` (PPM: render passes A ≤ i < B).
-    pub pass_range: Option<(u64, u64)>,
 }
 
 /// Everything needed to render.
@@ -88,13 +88,11 @@ pub struct RenderSetup {
     /// The camera.
     pub camera: Camera,
     /// The film.
-    pub film: RgbFilm,
+    pub film: Film,
     /// The prototype sampler.
     pub sampler: Sampler,
     /// The light transport algorithm.
     pub integrator: Box<dyn Integrator>,
-    /// Name of the integrator.
-    pub integrator_name: String,
     /// Output image path.
     pub outfile: PathBuf,
     /// Non-fatal problems (unused parameters, substitutions).
@@ -111,9 +109,19 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let (film, outfile) = entities::film(desc, ov, &mut warnings)?;
     let camera = entities::camera(desc, &film)?;
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
-    let (integrator, integrator_name, power_sampling) =
-        entities::integrator(desc, ov, &outfile, &mut warnings)?;
-    if integrator_name == "lightpath" && !camera.is_connectable() {
+    let built = integrators::integrator(desc, ov, &mut warnings)?;
+    let (integrator, power_sampling) = (built.integrator, built.power_sampling);
+    let film = if built.strategy_layers > 0 {
+        let layout = FilmLayout {
+            strategies: built.strategy_layers,
+            ..film.layout().clone()
+        };
+        film.with_layers(layout, FilmKind::Rgb, SurfaceSpace::World)
+    } else {
+        film
+    };
+    let kind = integrator.kind();
+    if kind == IntegratorKind::LightPath && !camera.is_connectable() {
         return Err(BuildError::Other(
             "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
         ));
@@ -144,7 +152,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
             sampler.samples_per_pixel(),
         )));
     }
-    if let Some(w) = photon_radius_warning(desc, &integrator_name, &scene)? {
+    if let Some(w) = photon_radius_warning(desc, kind, &scene)? {
         warnings.push(w);
     }
     collect_unused(desc, &textures_used, &mut warnings);
@@ -154,7 +162,6 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         film,
         sampler,
         integrator,
-        integrator_name,
         outfile,
         warnings,
     })
@@ -166,12 +173,13 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
 /// Warn when the radius is far from the scene's scale.
 fn photon_radius_warning(
     desc: &SceneDescription,
-    integrator: &str,
+    kind: IntegratorKind,
     scene: &Scene,
 ) -> Result<Option<String>, BuildError> {
-    let (Some(e), "sppm" | "ppm") = (&desc.integrator, integrator) else {
+    let (Some(e), IntegratorKind::Sppm | IntegratorKind::Ppm) = (&desc.integrator, kind) else {
         return Ok(None);
     };
+    let integrator = kind.name();
     let radius = e.params.get_float("radius", 1.0)?;
     let b = scene.bounds();
     let diagonal = (b.max - b.min).length();

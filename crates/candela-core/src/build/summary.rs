@@ -12,7 +12,6 @@ use crate::light::Light;
 use crate::shape::Shape;
 use candela_scene::{ParamSet, SceneDescription};
 use std::collections::BTreeMap;
-use std::fmt;
 
 /// Occurrences per name, in name order.
 pub type Counts = BTreeMap<String, usize>;
@@ -147,7 +146,7 @@ pub fn summarize(desc: &SceneDescription, setup: &RenderSetup) -> SceneSummary {
         camera: camera_line(desc),
         film: format!("rgb {}×{} → {}", res.x, res.y, setup.outfile.display()),
         sampler: sampler_line(sampler_name, setup),
-        integrator: format!("{}, maxdepth {max_depth}", setup.integrator_name),
+        integrator: format!("{}, maxdepth {max_depth}", setup.integrator.kind()),
         shapes: count(desc.shapes.iter().chain(defs).map(|s| s.name.as_str())),
         instances: desc.instances.len(),
         primitives: count(prims.iter().map(|p| shape_kind(&p.shape))),
@@ -162,41 +161,5 @@ pub fn summarize(desc: &SceneDescription, setup: &RenderSetup) -> SceneSummary {
         textures: count(desc.textures.iter().map(|t| t.class.as_str())),
         bounds: (!prims.is_empty()).then(|| (b.min.to_array(), b.max.to_array())),
         warnings: setup.warnings.clone(),
-    }
-}
-
-/// `total: a 1, b 2` (or `0`).
-fn counts_line(c: &Counts) -> String {
-    let total: usize = c.values().sum();
-    if total == 0 {
-        return "0".to_string();
-    }
-    let parts: Vec<String> = c.iter().map(|(k, v)| format!("{k} {v}")).collect();
-    format!("{total} ({})", parts.join(", "))
-}
-
-impl fmt::Display for SceneSummary {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "camera      {}", self.camera)?;
-        writeln!(f, "film        {}", self.film)?;
-        writeln!(f, "sampler     {}", self.sampler)?;
-        writeln!(f, "integrator  {}", self.integrator)?;
-        writeln!(f, "shapes      {}", counts_line(&self.shapes))?;
-        if self.instances > 0 {
-            writeln!(f, "instances   {}", self.instances)?;
-        }
-        writeln!(f, "primitives  {}", counts_line(&self.primitives))?;
-        writeln!(f, "triangles   {}", self.triangles)?;
-        writeln!(f, "lights      {}", counts_line(&self.lights))?;
-        writeln!(f, "materials   {}", counts_line(&self.materials))?;
-        writeln!(f, "textures    {}", counts_line(&self.textures))?;
-        if let Some((lo, hi)) = self.bounds {
-            writeln!(f, "bounds      {lo:?} – {hi:?}")?;
-        }
-        writeln!(f, "warnings    {}", self.warnings.len())?;
-        for w in &self.warnings {
-            writeln!(f, "  {w}")?;
-        }
-        Ok(())
     }
 }

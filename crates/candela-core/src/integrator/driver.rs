@@ -1,18 +1,18 @@
-//! The tiled, parallel, deterministic render loop for camera-driven estimators.
+//! The parallel, deterministic pixel loop of one pass.
 //!
 //! The image is cut into 16×16 tiles rendered in parallel by rayon. Every
-//! pixel sample reseeds the sampler from (pixel, sample index, seed), and
-//! each pixel is written by exactly one tile, so the image is bit-identical
-//! for any thread count and schedule.
+//! pixel sample reseeds the sampler from (pixel, pass, seed) and each pixel
+//! is written by exactly one tile, so a pass's block is bit-identical for
+//! any thread count and schedule.
 //!
 //! Estimators that splat (BDPT's t = 1 strategies) write into one of
-//! [`LANES`] full-raster splat buffers: tile i goes to lane i mod LANES, the
-//! tiles of a lane run in order, and lanes are merged in order. The sum is
-//! therefore the same for any thread count too.
+//! [`LANES`] splat buffers over the pixel bounds: tile i goes to lane
+//! i mod LANES, the tiles of a lane run in order, and lanes are added to the
+//! block in order, so splat sums do not depend on the thread count either.
 
-use super::{PixelEstimator, RenderContext};
+use super::{PassOutcome, PixelEstimator, RenderContext};
 use crate::camera::CameraSample;
-use crate::film::{FilmTile, RgbFilm, SplatBuffer};
+use crate::film::{Film, FilmTile, PassBlock, SplatBuffer};
 use crate::math::{UVec2, Vec2};
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
@@ -23,44 +23,71 @@ pub const TILE: u32 = 16;
 /// Splat lanes (fixed, so splat sums do not depend on the thread count).
 pub const LANES: usize = 8;
 
-/// Renders every pixel of `film` with `estimator`.
-pub fn render_pixels(est: &dyn PixelEstimator, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-    let tiles = tiles(film.pixel_bounds());
-    let spp = ctx.sampler.samples_per_pixel();
-    ctx.progress
-        .start(tiles.len() as u64 * spp as u64, "tile·spp");
+/// Renders sample `pass` of every pixel with `est` into `block`.
+pub fn render_pixels(
+    est: &dyn PixelEstimator,
+    ctx: &RenderContext<'_>,
+    pass: u64,
+    block: &mut PassBlock,
+) -> PassOutcome {
+    let tiles = tiles(ctx.film.pixel_bounds());
     let splats = est.splats();
-    let lanes: Vec<(Vec<FilmTile>, SplatBuffer)> = (0..LANES)
+    let lanes: Vec<(Vec<FilmTile>, Option<SplatBuffer>)> = (0..LANES)
         .into_par_iter()
         .map(|lane| {
-            let mut buf = if splats {
-                film.splat_buffer()
-            } else {
-                SplatBuffer::disabled()
-            };
+            let mut buf = splats.then(|| ctx.film.splat_buffer());
+            let mut disabled = None;
             let done: Vec<FilmTile> = tiles
                 .iter()
                 .skip(lane)
                 .step_by(LANES)
-                .map(|&(lo, hi)| {
-                    let tile = render_tile(est, ctx, film, lo, hi, &mut buf);
-                    ctx.progress.advance(spp as u64);
-                    tile
+                .map_while(|&(lo, hi)| {
+                    if ctx.cancelled() {
+                        return None;
+                    }
+                    let splat = match buf.as_mut() {
+                        Some(b) => b,
+                        None => disabled.get_or_insert_with(|| empty_splats(ctx.film)),
+                    };
+                    let tile = render_tile(est, ctx, pass, lo, hi, splat);
+                    ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
+                    Some(tile)
                 })
                 .collect();
             (done, buf)
         })
         .collect();
+    if ctx.cancelled() {
+        return PassOutcome::Cancelled;
+    }
     for (done, buf) in lanes {
-        for tile in done {
-            film.merge_tile(tile);
+        for tile in &done {
+            block.add_tile(tile);
         }
-        film.merge_splats(buf);
+        if let Some(b) = &buf {
+            block.add_splats(b);
+        }
     }
-    if splats {
-        film.set_splat_scale(1.0 / spp as f64);
-    }
-    ctx.progress.finish();
+    PassOutcome::Done
+}
+
+/// A splat buffer with no pixels, for estimators that never splat.
+fn empty_splats(film: &Film) -> SplatBuffer {
+    let lo = film.pixel_bounds().0;
+    SplatBuffer::empty_at(lo, film)
+}
+
+/// Runs `f` on every tile of the film in parallel; the results come back in
+/// scanline tile order, or `None` if the render was cancelled meanwhile.
+pub fn for_each_tile<T: Send>(
+    ctx: &RenderContext<'_>,
+    f: impl Fn(UVec2, UVec2) -> T + Sync,
+) -> Option<Vec<T>> {
+    let out: Vec<Option<T>> = tiles(ctx.film.pixel_bounds())
+        .into_par_iter()
+        .map(|(lo, hi)| (!ctx.cancelled()).then(|| f(lo, hi)))
+        .collect();
+    out.into_iter().collect()
 }
 
 /// The 16×16 tiles covering the pixel bounds, in scanline order.
@@ -78,39 +105,25 @@ pub(crate) fn tiles(bounds: (UVec2, UVec2)) -> Vec<(UVec2, UVec2)> {
 fn render_tile(
     est: &dyn PixelEstimator,
     ctx: &RenderContext<'_>,
-    film: &RgbFilm,
+    pass: u64,
     lo: UVec2,
     hi: UVec2,
     splats: &mut SplatBuffer,
 ) -> FilmTile {
-    let mut tile = film.tile(lo, hi);
+    let mut tile = ctx.film.tile(lo, hi);
     let mut sampler = ctx.sampler.clone();
     for y in lo.y..hi.y {
         for x in lo.x..hi.x {
             let pixel = UVec2::new(x, y);
-            for index in 0..sampler.samples_per_pixel() {
-                sampler.start_pixel_sample(pixel, index, 0);
-                render_sample(est, ctx, film, &mut tile, pixel, &mut sampler, splats);
-            }
+            sampler.start_pixel_sample(pixel, pass as u32, 0);
+            let Some(mut cs) = camera_sample(ctx, pixel, &mut sampler) else {
+                continue;
+            };
+            let l = est.li(ctx, cs.ray, &mut cs.lambda, &mut sampler, splats) * cs.ray_weight;
+            tile.add_sample(pixel, l, &cs.lambda, cs.filter_weight);
         }
     }
     tile
-}
-
-fn render_sample(
-    est: &dyn PixelEstimator,
-    ctx: &RenderContext<'_>,
-    film: &RgbFilm,
-    tile: &mut FilmTile,
-    pixel: UVec2,
-    sampler: &mut Sampler,
-    splats: &mut SplatBuffer,
-) {
-    let Some(mut cs) = camera_sample(ctx, film, pixel, sampler) else {
-        return;
-    };
-    let l = est.li(ctx, cs.ray, &mut cs.lambda, sampler, splats) * cs.ray_weight;
-    tile.add_sample(pixel, l, &cs.lambda, cs.filter_weight);
 }
 
 /// The primary ray of one pixel sample and what the film needs to record it.
@@ -129,12 +142,11 @@ pub(crate) struct PixelSample {
 /// pbrt-v4's `GetCameraSample` order, and generates the camera ray.
 pub(crate) fn camera_sample(
     ctx: &RenderContext<'_>,
-    film: &RgbFilm,
     pixel: UVec2,
     sampler: &mut Sampler,
 ) -> Option<PixelSample> {
     let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
-    let fs = film.filter().sample(sampler.get_pixel_2d());
+    let fs = ctx.film.filter().sample(sampler.get_pixel_2d());
     let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
     let time = ctx.scene.sample_time(|| sampler.get_1d());
     let p_lens = sampler.get_2d();

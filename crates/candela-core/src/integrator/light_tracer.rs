@@ -7,68 +7,101 @@
 //! β by f·|cos θ|/p in importance mode. Each vertex (the light point itself
 //! included) is connected to a sampled lens point; the camera's importance
 //! We, normalised to 1 over the whole film (seed §2.4), turns power into the
-//! pixel measurement. One light path is traced per pixel sample, so splats
-//! are scaled by 1/spp on output.
+//! pixel measurement. A pass traces one light path per pixel of the film,
+//! and the film averages the passes.
 //!
 //! Shading normals make importance transport non-symmetric; the adjoint
 //! correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) is applied at every
 //! scattering and connection [Veach 1997, eq. 5.19].
 //!
-//! Paths are processed in fixed batches whose splat buffers are merged in
-//! batch order: the image is bit-identical for any thread count.
+//! Paths are processed in chunks assigned to a fixed number of splat lanes,
+//! added in lane order: the image is bit-identical for any thread count.
 
-use super::{Integrator, RenderContext};
+use super::driver::LANES;
+use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
-use crate::film::{RgbFilm, SplatBuffer};
+use crate::film::{PassBlock, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec2;
 use crate::sampling::{hash_u64s, Pcg32};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
-/// Paths per splat buffer.
+/// Paths per work item.
 const PATHS_PER_CHUNK: u64 = 1 << 14;
-/// Chunks traced in parallel before their buffers are merged.
-const CHUNKS_PER_BATCH: u64 = 16;
 
-/// The light tracer.
-pub struct LightTracer {
+/// Parameters of `Integrator "lightpath"`.
+#[derive(Clone, Debug)]
+pub struct LightTracerSettings {
     /// Maximum number of scattering events of a path (as the path tracer's `maxdepth`).
     pub max_depth: u32,
     /// Seed of the path random numbers.
     pub seed: u64,
 }
 
+/// The light tracer.
+pub struct LightTracer {
+    /// Settings.
+    pub settings: LightTracerSettings,
+}
+
 impl Integrator for LightTracer {
-    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-        let res = film.resolution();
-        let spp = ctx.sampler.samples_per_pixel() as u64;
-        let n_paths = res.x as u64 * res.y as u64 * spp;
-        let n_chunks = n_paths.div_ceil(PATHS_PER_CHUNK);
-        ctx.progress.start(n_chunks, "chunks of 16384 light paths");
-        let mut first = 0;
-        while first < n_chunks {
-            let last = (first + CHUNKS_PER_BATCH).min(n_chunks);
-            let buffers: Vec<SplatBuffer> = (first..last)
-                .into_par_iter()
-                .map(|c| {
-                    let mut buf = film.splat_buffer();
-                    let end = ((c + 1) * PATHS_PER_CHUNK).min(n_paths);
-                    for i in c * PATHS_PER_CHUNK..end {
-                        self.trace_path(ctx, i, &mut buf);
-                    }
-                    ctx.progress.advance(1);
-                    buf
-                })
-                .collect();
-            for b in buffers {
-                film.merge_splats(b);
-            }
-            first = last;
-        }
-        film.set_splat_scale(1.0 / spp as f64);
-        ctx.progress.finish();
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::LightPath
     }
+
+    fn pass_work(&self, ctx: &RenderContext<'_>) -> PassWork {
+        PassWork {
+            units: paths_per_pass(ctx),
+            unit: "light paths",
+        }
+    }
+
+    /// Traces paths [pass·N, (pass + 1)·N), N the film's full pixel count: the
+    /// camera's importance is normalised over the whole film, so one pass is
+    /// one path per pixel of the full resolution, and the film's average over
+    /// passes is the estimate.
+    fn render_pass(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: u64,
+        _state: &mut IntegratorState,
+        block: &mut PassBlock,
+    ) -> PassOutcome {
+        let n = paths_per_pass(ctx);
+        let first = pass * n;
+        let n_chunks = n.div_ceil(PATHS_PER_CHUNK);
+        let lanes: Vec<SplatBuffer> = (0..LANES as u64)
+            .into_par_iter()
+            .map(|lane| {
+                let mut buf = ctx.film.splat_buffer();
+                for c in (lane..n_chunks).step_by(LANES) {
+                    if ctx.cancelled() {
+                        break;
+                    }
+                    let end = ((c + 1) * PATHS_PER_CHUNK).min(n);
+                    for i in c * PATHS_PER_CHUNK..end {
+                        self.trace_path(ctx, first + i, &mut buf);
+                    }
+                    ctx.advance(end - c * PATHS_PER_CHUNK);
+                }
+                buf
+            })
+            .collect();
+        if ctx.cancelled() {
+            return PassOutcome::Cancelled;
+        }
+        for b in &lanes {
+            block.add_splats(b);
+        }
+        PassOutcome::Done
+    }
+}
+
+/// Light paths per pass: the film's full resolution.
+fn paths_per_pass(ctx: &RenderContext<'_>) -> u64 {
+    let res = ctx.film.resolution();
+    res.x as u64 * res.y as u64
 }
 
 /// Uniform numbers of one path, seeded from (seed, path index).
@@ -90,7 +123,7 @@ impl LightTracer {
     /// Traces light path `index` and splats its camera connections.
     fn trace_path(&self, ctx: &RenderContext<'_>, index: u64, buf: &mut SplatBuffer) {
         let scene = ctx.scene;
-        let mut rng = PathRng::new(self.seed, index);
+        let mut rng = PathRng::new(self.settings.seed, index);
         let lambda = SampledWavelengths::sample_visible(rng.u1());
         let Some((id, p_light)) = scene.light_sampler().sample(rng.u1()) else {
             return;
@@ -125,7 +158,7 @@ impl LightTracer {
             // A connection here closes a path with `depth` scattering events, as
             // many as the path tracer allows for the same maxdepth.
             depth += 1;
-            if depth > self.max_depth {
+            if depth > self.settings.max_depth {
                 break;
             }
             let Some(bsdf) = scene.bsdf(&mut si, &mut lambda) else {

@@ -15,9 +15,12 @@
 //! that next-event estimation uses, `Bsdf::pdf`, or the two weights of one
 //! direction would not sum to one [pbrt-v4 §14.3.3, `PathIntegrator::Li`].
 
-use super::{driver, Integrator, PixelEstimator, RenderContext};
+use super::{
+    driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, PixelEstimator,
+    RenderContext,
+};
 use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
-use crate::film::{RgbFilm, SplatBuffer};
+use crate::film::{PassBlock, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
 use crate::light::LightSampleContext;
 use crate::math::{Ray, Vec3};
@@ -51,8 +54,23 @@ pub struct PathIntegrator {
 }
 
 impl Integrator for PathIntegrator {
-    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-        driver::render_pixels(self, ctx, film);
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::Path
+    }
+    fn pass_work(&self, ctx: &RenderContext<'_>) -> PassWork {
+        PassWork {
+            units: ctx.film.pixel_count() as u64,
+            unit: "samples",
+        }
+    }
+    fn render_pass(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: u64,
+        _state: &mut IntegratorState,
+        block: &mut PassBlock,
+    ) -> PassOutcome {
+        driver::render_pixels(self, ctx, pass, block)
     }
 }
 

@@ -8,7 +8,6 @@ pub mod stats;
 
 use candela_core::build::{build, Overrides};
 use candela_core::image::RgbImage;
-use candela_core::integrator::{NoProgress, RenderContext};
 use std::path::Path;
 
 /// Renders pbrt-v4 scene text with the given overrides; asserts no sample was dropped.
@@ -21,20 +20,21 @@ pub fn render_str(text: &str, ov: &Overrides) -> RgbImage {
 /// it); returns the image and the build warnings.
 pub fn render_at(text: &str, path: &Path, ov: &Overrides) -> (RgbImage, Vec<String>) {
     let desc = candela_scene::parse_str(text, path).expect("scene parses");
-    let mut setup = build(&desc, ov).expect("scene builds");
-    let ctx = RenderContext {
-        scene: &setup.scene,
-        camera: &setup.camera,
-        sampler: &setup.sampler,
-        progress: &NoProgress,
-    };
-    setup.integrator.render(&ctx, &mut setup.film);
-    assert_eq!(
-        setup.film.dropped_samples(),
-        0,
-        "non-finite samples were produced"
-    );
-    (setup.film.image(), setup.warnings)
+    let setup = build(&desc, ov).expect("scene builds");
+    let (image, state) = candela_core::render::render_all(&setup);
+    assert_eq!(state.film.dropped(), 0, "non-finite samples were produced");
+    (image.rgb(), setup.warnings)
+}
+
+/// Renders pbrt-v4 scene text and returns the developed film (every layer,
+/// BDPT's strategy images included).
+#[allow(dead_code)] // Not every test crate needs the layers.
+pub fn render_developed(text: &str, ov: &Overrides) -> candela_core::film::Developed {
+    let desc = candela_scene::parse_str(text, Path::new("test.pbrt")).expect("scene parses");
+    let setup = build(&desc, ov).expect("scene builds");
+    let (dev, state) = candela_core::render::render_all(&setup);
+    assert_eq!(state.film.dropped(), 0, "non-finite samples were produced");
+    dev
 }
 
 /// Mean and standard error of the mean of channel `c` over pixels in `[x0,x1)×[y0,y1)`.

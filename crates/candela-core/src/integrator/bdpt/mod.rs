@@ -16,7 +16,7 @@
 //! The pieces are free functions: [`walk::generate_camera_subpath`],
 //! [`walk::generate_light_subpath`], [`connect::connect`] and
 //! [`mis::mis_weight`]. Splats (t = 1) go through the driver's
-//! deterministic splat lanes and are scaled by 1/spp.
+//! deterministic splat lanes and are averaged over the passes.
 
 mod connect;
 mod mis;
@@ -29,8 +29,11 @@ mod walk;
 pub use mis::MisHeuristic;
 pub use visualize::Visualize;
 
-use super::{driver, Integrator, PixelEstimator, RenderContext};
-use crate::film::{RgbFilm, SplatBuffer};
+use super::{
+    driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, PixelEstimator,
+    RenderContext,
+};
+use crate::film::{PassBlock, SplatBuffer};
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -68,10 +71,25 @@ pub struct BdptIntegrator {
 }
 
 impl Integrator for BdptIntegrator {
-    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::Bdpt
+    }
+    fn pass_work(&self, ctx: &RenderContext<'_>) -> PassWork {
+        PassWork {
+            units: ctx.film.pixel_count() as u64,
+            unit: "samples",
+        }
+    }
+    fn render_pass(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: u64,
+        _state: &mut IntegratorState,
+        block: &mut PassBlock,
+    ) -> PassOutcome {
         match &self.settings.visualize {
-            Some(v) => visualize::render(self, v, ctx, film),
-            None => driver::render_pixels(self, ctx, film),
+            Some(v) => visualize::render_pass(self, v, ctx, pass, block),
+            None => driver::render_pixels(self, ctx, pass, block),
         }
     }
 }

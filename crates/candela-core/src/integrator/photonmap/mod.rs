@@ -68,14 +68,15 @@ mod maps;
 
 pub use maps::{Kernel, Lookup, Photon, PhotonMap};
 
-use super::{driver, Integrator, RenderContext};
-use crate::film::{FilmTile, RgbFilm};
+use super::{
+    driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext,
+};
+use crate::film::{FilmTile, PassBlock};
 use crate::math::UVec2;
 use crate::sampling::{hash_u64s, Pcg32};
 use crate::spectrum::SampledWavelengths;
 use camera::CameraWalk;
 use maps::PassMaps;
-use rayon::prelude::*;
 
 /// Default `maxradius` as a fraction of the scene's bounding-sphere radius.
 pub const DEFAULT_RELATIVE_RADIUS: f32 = 0.05;
@@ -130,26 +131,43 @@ pub struct PhotonMapIntegrator {
 }
 
 impl Integrator for PhotonMapIntegrator {
-    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-        let passes = ctx.sampler.samples_per_pixel();
-        ctx.progress.start(passes as u64, "passes");
-        let (global_lookup, caustic_lookup) = self.lookups(ctx);
-        for pass in 0..passes {
-            let lambda = pass_wavelengths(self.settings.seed, pass, passes);
-            let maps = PassMaps::shoot(ctx.scene, &lambda, &self.settings, pass as u64);
-            let walk = CameraWalk {
-                scene: ctx.scene,
-                maps: &maps,
-                settings: &self.settings,
-                global_lookup,
-                caustic_lookup,
-            };
-            for tile in render_pass(&walk, ctx, film, pass, &lambda) {
-                film.merge_tile(tile);
-            }
-            ctx.progress.advance(1);
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::PhotonMap
+    }
+
+    fn pass_work(&self, _ctx: &RenderContext<'_>) -> PassWork {
+        PassWork {
+            units: self.settings.photons + self.settings.caustic_photons,
+            unit: "photons",
         }
-        ctx.progress.finish();
+    }
+
+    fn render_pass(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: u64,
+        _state: &mut IntegratorState,
+        block: &mut PassBlock,
+    ) -> PassOutcome {
+        let passes = ctx.sampler.samples_per_pixel();
+        let (global_lookup, caustic_lookup) = self.lookups(ctx);
+        let lambda = pass_wavelengths(self.settings.seed, pass as u32, passes);
+        let maps = PassMaps::shoot(ctx.scene, &lambda, &self.settings, pass);
+        ctx.advance(self.settings.photons + self.settings.caustic_photons);
+        let walk = CameraWalk {
+            scene: ctx.scene,
+            maps: &maps,
+            settings: &self.settings,
+            global_lookup,
+            caustic_lookup,
+        };
+        let Some(tiles) = render_pass(&walk, ctx, pass as u32, &lambda) else {
+            return PassOutcome::Cancelled;
+        };
+        for tile in &tiles {
+            block.add_tile(tile);
+        }
+        PassOutcome::Done
     }
 }
 
@@ -181,36 +199,32 @@ pub fn pass_wavelengths(seed: u64, pass: u32, passes: u32) -> SampledWavelengths
 }
 
 /// Renders one camera sample per pixel for `pass`, tile by tile in parallel;
-/// the tiles come back in scanline order.
+/// the tiles come back in scanline order (`None` if cancelled).
 fn render_pass(
     walk: &CameraWalk<'_>,
     ctx: &RenderContext<'_>,
-    film: &RgbFilm,
     pass: u32,
     lambda: &SampledWavelengths,
-) -> Vec<FilmTile> {
-    driver::tiles(film.pixel_bounds())
-        .into_par_iter()
-        .map(|(lo, hi)| {
-            let mut tile = film.tile(lo, hi);
-            let mut sampler = ctx.sampler.clone();
-            let mut scratch = Vec::new();
-            for y in lo.y..hi.y {
-                for x in lo.x..hi.x {
-                    let pixel = UVec2::new(x, y);
-                    sampler.start_pixel_sample(pixel, pass, 0);
-                    // The driver's camera sample, with the pass wavelengths
-                    // replacing the ones it draws (that draw keeps the sampler
-                    // dimensions aligned with the other integrators').
-                    let Some(mut cs) = driver::camera_sample(ctx, film, pixel, &mut sampler) else {
-                        continue;
-                    };
-                    cs.lambda = *lambda;
-                    let l = walk.li(cs.ray, &mut cs.lambda, &mut sampler, &mut scratch);
-                    tile.add_sample(pixel, l * cs.ray_weight, &cs.lambda, cs.filter_weight);
-                }
+) -> Option<Vec<FilmTile>> {
+    driver::for_each_tile(ctx, |lo, hi| {
+        let mut tile = ctx.film.tile(lo, hi);
+        let mut sampler = ctx.sampler.clone();
+        let mut scratch = Vec::new();
+        for y in lo.y..hi.y {
+            for x in lo.x..hi.x {
+                let pixel = UVec2::new(x, y);
+                sampler.start_pixel_sample(pixel, pass, 0);
+                // The driver's camera sample, with the pass wavelengths
+                // replacing the ones it draws (that draw keeps the sampler
+                // dimensions aligned with the other integrators').
+                let Some(mut cs) = driver::camera_sample(ctx, pixel, &mut sampler) else {
+                    continue;
+                };
+                cs.lambda = *lambda;
+                let l = walk.li(cs.ray, &mut cs.lambda, &mut sampler, &mut scratch);
+                tile.add_sample(pixel, l * cs.ray_weight, &cs.lambda, cs.filter_weight);
             }
-            tile
-        })
-        .collect()
+        }
+        tile
+    })
 }

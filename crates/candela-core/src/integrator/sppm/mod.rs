@@ -24,11 +24,11 @@ mod ppm;
 #[cfg(test)]
 mod tests;
 
-pub use ppm::{ppm_radius2, PpmIntegrator, PpmPartial, PpmSettings};
+pub use ppm::{ppm_radius2, PpmIntegrator, PpmSettings};
 
 use super::photon::ShootSettings;
-use super::{Integrator, RenderContext};
-use crate::film::RgbFilm;
+use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
+use crate::film::PassBlock;
 use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list};
 
 /// α of the radius reduction (Hachisuka & Jensen recommend 2/3).
@@ -77,6 +77,16 @@ pub struct PixelStats {
     pub ld: [f64; 3],
 }
 
+/// SPPM's state between iterations: the statistics of every pixel of the
+/// film's pixel bounds, in scanline order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SppmState {
+    /// Photons shot per iteration.
+    pub photons_per_iteration: u64,
+    /// Per-pixel statistics.
+    pub stats: Vec<PixelStats>,
+}
+
 /// One SPPM update after a pass with `m` photons of flux `phi` (sensor RGB)
 /// [Hachisuka & Jensen 2009, eqs. 6–7]; the radius stays when m = 0.
 pub fn sppm_update(s: &PixelStats, m: f64, phi: [f64; 3], alpha: f64) -> PixelStats {
@@ -112,60 +122,90 @@ impl SppmSettings {
 }
 
 impl Integrator for SppmIntegrator {
-    fn render(&self, ctx: &RenderContext<'_>, film: &mut RgbFilm) {
-        let st = &self.settings;
-        let pixels = pixel_list(film);
-        let n_photons = st.photons(pixels.len());
-        let iterations = ctx.sampler.samples_per_pixel();
-        let r0 = st.radius as f64;
-        let mut stats = vec![
-            PixelStats {
-                r2: r0 * r0,
-                ..Default::default()
-            };
-            pixels.len()
-        ];
-        ctx.progress.start(iterations as u64, "iterations");
-        let t0 = std::time::Instant::now();
-        for iter in 0..iterations {
-            let lambda = pass_wavelengths(st.seed, iter as u64);
-            let visits = camera_pass(ctx, film, &pixels, iter, &lambda, st.max_depth);
-            let radius: Vec<f32> = stats.iter().map(|s| s.r2.sqrt() as f32).collect();
-            let shoot = st.shoot();
-            let gathered = photon_pass(
-                ctx.scene,
-                &visits,
-                &radius,
-                &lambda,
-                &shoot,
-                iter as u64,
-                n_photons,
-            );
-            for ((s, v), g) in stats.iter_mut().zip(&visits).zip(&gathered) {
-                for c in 0..3 {
-                    s.ld[c] += v.ld[c] as f64;
-                }
-                let phi = match &v.vp {
-                    Some(vp) if g.m > 0 => film.sensor().to_sensor_rgb(vp.beta * g.phi, &lambda),
-                    _ => [0.0; 3],
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::Sppm
+    }
+
+    fn pass_work(&self, ctx: &RenderContext<'_>) -> PassWork {
+        PassWork {
+            units: self.settings.photons(ctx.film.pixel_count()),
+            unit: "photons",
+        }
+    }
+
+    fn initial_state(&self, ctx: &RenderContext<'_>) -> IntegratorState {
+        let r0 = self.settings.radius as f64;
+        IntegratorState::Sppm(SppmState {
+            photons_per_iteration: self.settings.photons(ctx.film.pixel_count()),
+            stats: vec![
+                PixelStats {
+                    r2: r0 * r0,
+                    ..Default::default()
                 };
-                *s = sppm_update(s, g.m as f64, phi.map(|v| v as f64), ALPHA);
+                ctx.film.pixel_count()
+            ],
+        })
+    }
+
+    fn render_pass(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: u64,
+        state: &mut IntegratorState,
+        _block: &mut PassBlock,
+    ) -> PassOutcome {
+        let IntegratorState::Sppm(st) = state else {
+            return PassOutcome::Cancelled;
+        };
+        let s = &self.settings;
+        let pixels = pixel_list(ctx.film);
+        let lambda = pass_wavelengths(s.seed, pass);
+        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &lambda, s.max_depth) else {
+            return PassOutcome::Cancelled;
+        };
+        let radius: Vec<f32> = st.stats.iter().map(|p| p.r2.sqrt() as f32).collect();
+        let n = st.photons_per_iteration;
+        let Some(gathered) = photon_pass(ctx, &visits, &radius, &lambda, &s.shoot(), pass, n)
+        else {
+            return PassOutcome::Cancelled;
+        };
+        for ((p, v), g) in st.stats.iter_mut().zip(&visits).zip(&gathered) {
+            let ld = ctx.film.sensor().to_sensor_rgb(v.ld, &v.lambda);
+            for (sum, v) in p.ld.iter_mut().zip(ld) {
+                *sum += v as f64;
             }
-            ctx.progress.advance(1);
-            let mean_r = stats.iter().map(|s| s.r2.sqrt()).sum::<f64>() / stats.len().max(1) as f64;
-            let rate = (iter as f64 + 1.0) * n_photons as f64 / t0.elapsed().as_secs_f64();
-            ctx.progress.message(&format!(
-                "{:.2} M photons/s, mean radius {mean_r:.4}",
-                rate / 1e6
-            ));
+            let phi = match &v.vp {
+                Some(vp) if g.m > 0 => ctx.film.sensor().to_sensor_rgb(vp.beta * g.phi, &v.lambda),
+                _ => [0.0; 3],
+            };
+            *p = sppm_update(p, g.m as f64, phi.map(|v| v as f64), ALPHA);
         }
-        let np = iterations as f64 * n_photons as f64;
-        for (p, s) in pixels.iter().zip(&stats) {
-            let rgb = [0, 1, 2].map(|c| {
-                s.ld[c] / iterations as f64 + s.tau[c] / (np * std::f64::consts::PI * s.r2)
-            });
-            film.set_pixel_sensor_rgb(*p, rgb);
-        }
-        ctx.progress.finish();
+        PassOutcome::Done
+    }
+
+    /// L = Ld/I + τ/(I·N_p·πR²) after I iterations of N_p photons.
+    fn develop_overlay(&self, state: &IntegratorState, passes: u64) -> Option<Vec<[f64; 3]>> {
+        let IntegratorState::Sppm(st) = state else {
+            return None;
+        };
+        let i = passes.max(1) as f64;
+        let np = i * st.photons_per_iteration as f64;
+        Some(
+            st.stats
+                .iter()
+                .map(|s| {
+                    [0, 1, 2].map(|c| s.ld[c] / i + s.tau[c] / (np * std::f64::consts::PI * s.r2))
+                })
+                .collect(),
+        )
+    }
+
+    fn status(&self, state: &IntegratorState, _next_pass: u64) -> Option<String> {
+        let IntegratorState::Sppm(st) = state else {
+            return None;
+        };
+        let mean_r =
+            st.stats.iter().map(|s| s.r2.sqrt()).sum::<f64>() / st.stats.len().max(1) as f64;
+        Some(format!("mean radius {mean_r:.4}"))
     }
 }

@@ -26,14 +26,13 @@
 //! their contributions as lists merged in chunk order: deterministic.
 
 use crate::bsdf::{Bsdf, BxdfFlags, SampleFlags, TransportMode};
-use crate::film::RgbFilm;
+use crate::film::Film;
 use crate::integrator::direct::light_sampled_direct;
 use crate::integrator::driver::camera_sample;
 use crate::integrator::photon::{trace_photon, ShootSettings};
 use crate::integrator::RenderContext;
 use crate::math::{UVec2, Vec3};
 use crate::sampler::Sampler;
-use crate::scene::Scene;
 use crate::spatial::{HasSphere, SphereGrid};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
@@ -58,57 +57,67 @@ pub struct VisiblePoint {
 /// What the camera pass found for one pixel.
 #[derive(Clone, Copy, Debug)]
 pub struct PixelVisit {
-    /// Direct light, in sensor RGB.
-    pub ld: [f32; 3],
+    /// Direct light (and emission seen through specular chains).
+    pub ld: SampledSpectrum,
+    /// The wavelengths of the pixel's path (the pass's, possibly with the
+    /// secondary ones terminated by dispersion).
+    pub lambda: SampledWavelengths,
     /// The visible point, if the path found one.
     pub vp: Option<VisiblePoint>,
 }
 
 /// Pixels of the film's bounds in scanline order.
-pub fn pixel_list(film: &RgbFilm) -> Vec<UVec2> {
+pub fn pixel_list(film: &Film) -> Vec<UVec2> {
     let (lo, hi) = film.pixel_bounds();
     (lo.y..hi.y)
         .flat_map(|y| (lo.x..hi.x).map(move |x| UVec2::new(x, y)))
         .collect()
 }
 
-/// The camera pass of iteration `iter` at wavelengths `lambda`.
+/// The camera pass of iteration `iter` at wavelengths `lambda` (`None` if
+/// the render was cancelled meanwhile).
 pub fn camera_pass(
     ctx: &RenderContext<'_>,
-    film: &RgbFilm,
     pixels: &[UVec2],
     iter: u32,
     lambda: &SampledWavelengths,
     max_depth: u32,
-) -> Vec<PixelVisit> {
-    pixels
+) -> Option<Vec<PixelVisit>> {
+    let chunks: Vec<Option<Vec<PixelVisit>>> = pixels
         .par_chunks(256)
-        .flat_map_iter(|chunk| {
+        .map(|chunk| {
+            if ctx.cancelled() {
+                return None;
+            }
             let mut sampler = ctx.sampler.clone();
-            chunk
-                .iter()
-                .map(|&pixel| {
-                    sampler.start_pixel_sample(pixel, iter, 0);
-                    visit_pixel(ctx, film, pixel, lambda, max_depth, &mut sampler)
-                })
-                .collect::<Vec<_>>()
+            Some(
+                chunk
+                    .iter()
+                    .map(|&pixel| {
+                        sampler.start_pixel_sample(pixel, iter, 0);
+                        visit_pixel(ctx, pixel, lambda, max_depth, &mut sampler)
+                    })
+                    .collect(),
+            )
         })
-        .collect()
+        .collect();
+    let chunks: Option<Vec<Vec<PixelVisit>>> = chunks.into_iter().collect();
+    Some(chunks?.into_iter().flatten().collect())
 }
 
 fn visit_pixel(
     ctx: &RenderContext<'_>,
-    film: &RgbFilm,
     pixel: UVec2,
     lambda: &SampledWavelengths,
     max_depth: u32,
     sampler: &mut Sampler,
 ) -> PixelVisit {
     let mut visit = PixelVisit {
-        ld: [0.0; 3],
+        ld: SampledSpectrum::zero(),
+        lambda: *lambda,
         vp: None,
     };
-    let Some(cs) = camera_sample(ctx, film, pixel, sampler) else {
+    let Some(cs) = camera_sample(ctx, pixel, sampler) else {
         return visit;
     };
     let scene = ctx.scene;
@@ -166,7 +175,8 @@ fn visit_pixel(
         ray = si.spawn_ray(bs.wi);
         depth += 1;
     }
-    visit.ld = film.sensor().to_sensor_rgb(ld, &lam);
+    visit.ld = ld;
+    visit.lambda = lam;
     visit
 }
 
@@ -195,16 +205,17 @@ pub struct Gathered {
 const CHUNK: u64 = 4096;
 
 /// Shoots `n_photons` photons of pass `pass` and gathers them at the visible
-/// points, each with its own radius `radius[i]`.
+/// points, each with its own radius `radius[i]` (`None` if cancelled).
 pub fn photon_pass(
-    scene: &Scene,
+    ctx: &RenderContext<'_>,
     visits: &[PixelVisit],
     radius: &[f32],
     lambda: &SampledWavelengths,
     shoot: &ShootSettings,
     pass: u64,
     n_photons: u64,
-) -> Vec<Gathered> {
+) -> Option<Vec<Gathered>> {
+    let scene = ctx.scene;
     let spheres: Vec<Sphere> = visits
         .iter()
         .zip(radius)
@@ -214,9 +225,12 @@ pub fn photon_pass(
         })
         .collect();
     let grid = SphereGrid::build(&spheres);
-    let lists: Vec<Vec<(u32, SampledSpectrum)>> = (0..n_photons.div_ceil(CHUNK))
+    let lists: Vec<Option<Vec<(u32, SampledSpectrum)>>> = (0..n_photons.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
+            if ctx.cancelled() {
+                return None;
+            }
             let mut out = Vec::new();
             for i in c * CHUNK..((c + 1) * CHUNK).min(n_photons) {
                 trace_photon(scene, lambda, shoot, pass, i, |h| {
@@ -241,18 +255,20 @@ pub fn photon_pass(
                     });
                 });
             }
-            out
+            ctx.advance(CHUNK.min(n_photons - c * CHUNK));
+            Some(out)
         })
         .collect();
     let mut gathered = vec![Gathered::default(); visits.len()];
     for list in lists {
+        let list = list?;
         for (j, phi) in list {
             let g = &mut gathered[j as usize];
             g.phi += phi;
             g.m += 1;
         }
     }
-    gathered
+    Some(gathered)
 }
 
 /// Applies the rotation taking unit vector `a` to unit vector `b` (a·b > 0)

@@ -57,29 +57,3 @@ fn ppm_radius_schedule_matches_the_closed_form() {
     }
     assert_eq!(ppm_radius2(1, ALPHA), 1.0);
 }
-
-#[test]
-fn ppm_partials_merge_exactly_and_reject_overlaps() {
-    let part = |passes, v: i128| ppm::PpmPartial {
-        origin: crate::math::UVec2::new(0, 0),
-        size: crate::math::UVec2::new(2, 1),
-        passes,
-        sums: vec![[v, 2 * v, -v]; 2],
-    };
-    let mut a = part((0, 3), 5);
-    a.merge(&part((3, 7), 1 << 100)).expect("disjoint");
-    assert_eq!(a.passes, (0, 7));
-    assert_eq!(
-        a.sums[1],
-        [5 + (1 << 100), 10 + (1 << 101), -5 - (1 << 100)]
-    );
-    assert!(a.clone().merge(&part((6, 9), 1)).is_err(), "overlap");
-    let dir = std::env::temp_dir().join(format!("candela-ppm-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("dir");
-    let f = dir.join("a.ppmpart");
-    a.save(&f).expect("save");
-    assert_eq!(ppm::PpmPartial::load(&f).expect("load"), a);
-    std::fs::write(&f, b"CNDLPPM1 truncated").expect("write");
-    assert!(ppm::PpmPartial::load(&f).is_err());
-    std::fs::remove_dir_all(&dir).ok();
-}

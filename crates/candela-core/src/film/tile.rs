@@ -1,0 +1,300 @@
+//! What one thread writes during a pass: a [`FilmTile`] of filtered camera
+//! samples for a rectangle of pixels, or a [`SplatBuffer`] of direct values
+//! (light-tracing splats, per-pass pixel estimates) over the film's pixel
+//! bounds. Both hold f64 sums of one pass; the pass block gathers them in a
+//! fixed order and the film state quantises them ([`super::fixed`]).
+//!
+//! A splat at raster position p adds f(p − c)/∫f to every pixel centre c
+//! within the filter's radius, as in pbrt-v4, so splatted and filtered camera
+//! samples reconstruct the same image.
+
+use super::filter::Filter;
+use super::layout::{self, Buckets, FilmLayout, SurfaceAov};
+use crate::math::{UVec2, Vec2};
+use crate::spectrum::{PixelSensor, SampledSpectrum, SampledWavelengths};
+
+/// Scales `rgb` so its largest component is at most `max_component`
+/// (pbrt-v4's `maxcomponentvalue`); returns the factor applied.
+#[inline]
+pub(crate) fn clamp_rgb(rgb: [f32; 3], max_component: f32) -> ([f32; 3], f32) {
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m > max_component {
+        let s = max_component / m;
+        (rgb.map(|v| v * s), s)
+    } else {
+        (rgb, 1.0)
+    }
+}
+
+/// Everything a tile or splat buffer needs to turn spectra into channels.
+#[derive(Clone, Debug)]
+pub(crate) struct Encoder {
+    pub sensor: PixelSensor,
+    pub max_component_value: f32,
+    pub buckets: Option<Buckets>,
+}
+
+impl Encoder {
+    /// Sensor RGB of `l` (clamped) and the clamp factor.
+    #[inline]
+    fn rgb(&self, l: SampledSpectrum, lambda: &SampledWavelengths) -> ([f32; 3], f32) {
+        clamp_rgb(
+            self.sensor.to_sensor_rgb(l, lambda),
+            self.max_component_value,
+        )
+    }
+
+    /// Adds w·L/(p(λ)·n) of each wavelength to its bucket (pbrt-v4's
+    /// `SpectralFilm::AddSample`); `weights`, if given, gets w per wavelength.
+    fn add_spectral(
+        &self,
+        l: SampledSpectrum,
+        lambda: &SampledWavelengths,
+        w: f64,
+        sums: &mut [f64],
+        mut weights: Option<&mut [f64]>,
+    ) {
+        let Some(b) = self.buckets else { return };
+        let lm = l.max_component();
+        let l = if lm > self.max_component_value {
+            l * (self.max_component_value / lm)
+        } else {
+            l
+        };
+        let n = l.0.len() as f32;
+        let pdf = lambda.pdf();
+        for i in 0..l.0.len() {
+            let Some(k) = b.bucket(lambda.lambda(i)) else {
+                continue;
+            };
+            if pdf.0[i] > 0.0 {
+                sums[k] += w * (l.0[i] / (pdf.0[i] * n)) as f64;
+            }
+            if let Some(ws) = weights.as_deref_mut() {
+                ws[k] += w;
+            }
+        }
+    }
+}
+
+/// Filtered camera samples of one pass over the pixels `[lo, hi)`.
+pub struct FilmTile {
+    pub(crate) lo: UVec2,
+    pub(crate) hi: UVec2,
+    pub(crate) stride: usize,
+    pub(crate) rows: Vec<f64>,
+    layout: FilmLayout,
+    enc: Encoder,
+    pub(crate) dropped: u64,
+}
+
+/// First-hit values of one camera sample (see [`SurfaceAov`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SurfaceSample {
+    /// Albedo in output RGB.
+    pub albedo: [f32; 3],
+    /// Position.
+    pub p: [f32; 3],
+    /// Geometric normal.
+    pub n: [f32; 3],
+    /// Shading normal.
+    pub ns: [f32; 3],
+    /// Distance from the lens.
+    pub depth: f32,
+    /// Surface (u, v).
+    pub uv: [f32; 2],
+    /// |∂z/∂x|, |∂z/∂y|.
+    pub dz: [f32; 2],
+}
+
+impl SurfaceSample {
+    fn values(&self, aov: SurfaceAov) -> &[f32] {
+        match aov {
+            SurfaceAov::Albedo => &self.albedo,
+            SurfaceAov::Position => &self.p,
+            SurfaceAov::Normal => &self.n,
+            SurfaceAov::ShadingNormal => &self.ns,
+            SurfaceAov::Depth => std::slice::from_ref(&self.depth),
+            SurfaceAov::Uv => &self.uv,
+            SurfaceAov::DepthGradient => &self.dz,
+        }
+    }
+}
+
+impl FilmTile {
+    pub(crate) fn new(lo: UVec2, hi: UVec2, layout: &FilmLayout, enc: Encoder) -> Self {
+        let stride = layout.pass_stride();
+        let n = ((hi.x - lo.x) * (hi.y - lo.y)) as usize;
+        Self {
+            lo,
+            hi,
+            stride,
+            rows: vec![0.0; n * stride],
+            layout: layout.clone(),
+            enc,
+            dropped: 0,
+        }
+    }
+
+    #[inline]
+    fn row_range(&self, pixel: UVec2) -> std::ops::Range<usize> {
+        let w = self.hi.x - self.lo.x;
+        let i = ((pixel.y - self.lo.y) * w + (pixel.x - self.lo.x)) as usize;
+        i * self.stride..(i + 1) * self.stride
+    }
+
+    /// Adds one camera sample of radiance `l` with filter weight `weight`.
+    /// Non-finite samples are dropped and counted, never written.
+    pub fn add_sample(
+        &mut self,
+        pixel: UVec2,
+        l: SampledSpectrum,
+        lambda: &SampledWavelengths,
+        weight: f32,
+    ) {
+        if l.has_non_finite() || !weight.is_finite() {
+            self.dropped += 1;
+            return;
+        }
+        let (rgb, _) = self.enc.rgb(l, lambda);
+        let w = weight as f64;
+        let nb = self.layout.n_buckets();
+        let so = self.layout.spectral_offset();
+        let range = self.row_range(pixel);
+        let row = &mut self.rows[range];
+        for (c, v) in rgb.iter().enumerate() {
+            row[layout::MAIN_WRGB + c] += w * *v as f64;
+        }
+        row[layout::MAIN_W] += w;
+        if nb > 0 {
+            let (sums, weights) = row[so..so + 2 * nb].split_at_mut(nb);
+            self.enc.add_spectral(l, lambda, w, sums, Some(weights));
+        }
+    }
+
+    /// Adds the first-hit values of one camera sample with weight `weight`.
+    pub fn add_surface(&mut self, pixel: UVec2, s: &SurfaceSample, weight: f32) {
+        if self.layout.surface.is_empty() || !weight.is_finite() {
+            return;
+        }
+        let w = weight as f64;
+        let range = self.row_range(pixel);
+        let (layout, row) = (&self.layout, &mut self.rows[range]);
+        row[layout.surface_offset()] += w;
+        for &aov in &layout.surface {
+            let Some(o) = layout.surface_channel(aov) else {
+                continue;
+            };
+            for (k, v) in s.values(aov).iter().enumerate() {
+                if v.is_finite() {
+                    row[o + k] += w * *v as f64;
+                }
+            }
+        }
+    }
+}
+
+/// Direct values of one pass over the film's pixel bounds.
+pub struct SplatBuffer {
+    pub(crate) lo: UVec2,
+    pub(crate) hi: UVec2,
+    /// Channels per pixel: rgb, then the spectral buckets.
+    pub(crate) stride: usize,
+    pub(crate) sums: Vec<f64>,
+    filter: Filter,
+    inv_filter_integral: f32,
+    enc: Encoder,
+    pub(crate) dropped: u64,
+}
+
+impl SplatBuffer {
+    pub(crate) fn new(lo: UVec2, hi: UVec2, filter: Filter, enc: Encoder) -> Self {
+        let stride = 3 + enc.buckets.map_or(0, |b| b.n);
+        let n = ((hi.x - lo.x) * (hi.y - lo.y)) as usize;
+        Self {
+            lo,
+            hi,
+            stride,
+            sums: vec![0.0; n * stride],
+            inv_filter_integral: 1.0 / filter.integral(),
+            filter,
+            enc,
+            dropped: 0,
+        }
+    }
+
+    #[inline]
+    fn index(&self, x: u32, y: u32) -> usize {
+        (((y - self.lo.y) * (self.hi.x - self.lo.x) + (x - self.lo.x)) as usize) * self.stride
+    }
+
+    /// Adds radiance-weighted importance `l` at raster position `p`, filtered
+    /// over the pixels around it (ignored outside the pixel bounds;
+    /// non-finite values are dropped and counted).
+    pub fn add(&mut self, p: Vec2, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        if l.has_non_finite() {
+            self.dropped += 1;
+            return;
+        }
+        let r = self.filter.radius();
+        // Pixel centres within the radius: c = i + ½ with |p − c| ≤ r.
+        let x0 = ((p.x - 0.5 - r.x).ceil().max(self.lo.x as f32)) as i64;
+        let y0 = ((p.y - 0.5 - r.y).ceil().max(self.lo.y as f32)) as i64;
+        let x1 = ((p.x - 0.5 + r.x).floor().min(self.hi.x as f32 - 1.0)) as i64;
+        let y1 = ((p.y - 0.5 + r.y).floor().min(self.hi.y as f32 - 1.0)) as i64;
+        if x0 > x1 || y0 > y1 {
+            return;
+        }
+        let (rgb, _) = self.enc.rgb(l, lambda);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let c = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let w = self.filter.evaluate(p - c) * self.inv_filter_integral;
+                if w == 0.0 {
+                    continue;
+                }
+                let i = self.index(x as u32, y as u32);
+                for (k, v) in rgb.iter().enumerate() {
+                    self.sums[i + k] += (w * *v) as f64;
+                }
+                if self.stride > 3 {
+                    let spectral = &mut self.sums[i + 3..i + self.stride];
+                    self.enc.add_spectral(l, lambda, w as f64, spectral, None);
+                }
+            }
+        }
+    }
+
+    /// Adds an estimate of the radiance of `pixel` itself (PPM's per-pass
+    /// pixel values: no filtering); non-finite values are dropped and counted.
+    pub fn add_pixel(&mut self, pixel: UVec2, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        if l.has_non_finite() {
+            self.dropped += 1;
+            return;
+        }
+        if pixel.x < self.lo.x
+            || pixel.y < self.lo.y
+            || pixel.x >= self.hi.x
+            || pixel.y >= self.hi.y
+        {
+            return;
+        }
+        let (rgb, _) = self.enc.rgb(l, lambda);
+        let i = self.index(pixel.x, pixel.y);
+        for (k, v) in rgb.iter().enumerate() {
+            self.sums[i + k] += *v as f64;
+        }
+        if self.stride > 3 {
+            let spectral = &mut self.sums[i + 3..i + self.stride];
+            self.enc.add_spectral(l, lambda, 1.0, spectral, None);
+        }
+    }
+}
+
+impl SplatBuffer {
+    /// A buffer over no pixels: every splat falls outside and is ignored
+    /// (for estimators that never splat).
+    pub fn empty_at(lo: UVec2, film: &super::Film) -> Self {
+        SplatBuffer::new(lo, lo, film.filter().clone(), film.encoder_for_empty())
+    }
+}

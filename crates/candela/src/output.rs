@@ -1,0 +1,51 @@
+//! Writing a developed film: the EXR (every layer, the number of passes in
+//! the header), a tone-mapped PNG beside it, BDPT's strategy images, all
+//! through temporary files renamed into place.
+
+use anyhow::{bail, Context, Result};
+use candela_core::film::Developed;
+use std::path::{Path, PathBuf};
+
+/// The EXR path for `outfile` (`.exr`, or `.png` meaning an EXR beside it);
+/// any other extension is an error naming the flag or the scene parameter.
+pub fn exr_path(outfile: &Path) -> Result<PathBuf> {
+    let ext = outfile.extension().map(|e| e.to_ascii_lowercase());
+    match ext.as_ref().and_then(|e| e.to_str()) {
+        Some("exr") => Ok(outfile.to_path_buf()),
+        Some("png") => Ok(outfile.with_extension("exr")),
+        _ => bail!(
+            "output file {} must end in .exr (a .png is written beside it)",
+            outfile.display()
+        ),
+    }
+}
+
+/// Checks before rendering that `exr` can be written: its directory exists
+/// (or is created) and accepts a file.
+pub fn check_writable(exr: &Path) -> Result<()> {
+    let dir = exr
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let probe = dir.join(format!(".candela-write-test-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .with_context(|| format!("cannot write output files in {}", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Writes the developed image as `exr` and a PNG beside it, and strategy
+/// images (`names[k]`) in the same directory.
+pub fn write(dev: &Developed, exr: &Path, strategy_names: &[Option<String>]) -> Result<()> {
+    let img = dev.rgb();
+    img.write_exr(exr)?;
+    img.write_png(&exr.with_extension("png"), 0.0)?;
+    let dir = exr.parent().unwrap_or(Path::new(""));
+    for (img, name) in dev.strategies.iter().zip(strategy_names) {
+        if let Some(name) = name {
+            img.write_exr(&dir.join(name))?;
+        }
+    }
+    Ok(())
+}

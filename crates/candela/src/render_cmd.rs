@@ -1,0 +1,373 @@
+//! `candela render` and `candela merge`: flags → render loop → outputs.
+
+use crate::output;
+use crate::progress;
+use anyhow::{bail, Context, Result};
+use candela_core::build::{build, Overrides, RenderSetup};
+use candela_core::film::develop::develop;
+use candela_core::integrator::{IntegratorKind, Visualize};
+use candela_core::render::{self, RenderOptions, RenderState, StopReason};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Exit code of a render stopped by a signal (after writing its outputs).
+const EXIT_INTERRUPTED: i32 = 130;
+
+/// Parses "A..B" (A < B).
+fn parse_range(s: &str) -> Result<(u64, u64), String> {
+    let (a, b) = s.split_once("..").ok_or("expected A..B")?;
+    let a: u64 = a.trim().parse().map_err(|e| format!("{a:?}: {e}"))?;
+    let b: u64 = b.trim().parse().map_err(|e| format!("{b:?}: {e}"))?;
+    if a >= b {
+        return Err(format!("empty pass range {a}..{b}"));
+    }
+    Ok((a, b))
+}
+
+/// Parses a positive, finite number of seconds.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "expected a positive number of seconds, found {s:?}"
+        )),
+    }
+}
+
+/// Parses a relative error in (0, 1).
+fn parse_error(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!(
+            "expected a relative error between 0 and 1, found {s:?}"
+        )),
+    }
+}
+
+/// Parses a sample count ≥ 1.
+fn parse_spp(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(v) if v >= 1 => Ok(v),
+        _ => Err(format!(
+            "expected a whole number of at least 1, found {s:?}"
+        )),
+    }
+}
+
+/// `candela render` flags.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Scene file (.pbrt, optionally .gz).
+    pub scene: PathBuf,
+    /// Passes: samples per pixel for path, lightpath and bdpt; iterations for
+    /// the photon integrators (overrides the Sampler's "pixelsamples").
+    #[arg(long, value_parser = parse_spp)]
+    pub spp: Option<u32>,
+    /// Render only passes A ≤ i < B of the --spp passes and write their exact
+    /// state beside the image (OUTFILE.passes-A-B.cndl, or --checkpoint) for
+    /// `candela merge`. Not for sppm, whose passes depend on each other.
+    #[arg(long, value_parser = parse_range)]
+    pub pass_range: Option<(u64, u64)>,
+    /// Integrator name (overrides the Integrator directive).
+    #[arg(long)]
+    pub integrator: Option<String>,
+    /// Output EXR path (a PNG is written beside it).
+    #[arg(long)]
+    pub outfile: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub nthreads: Option<usize>,
+    /// Sampler seed (overrides the Sampler's "seed").
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// No progress display or statistics.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Parse and build the scene, print what `candela info` prints, and stop.
+    #[arg(long)]
+    pub check_only: bool,
+    /// Where the render's state is written when it stops early, every
+    /// --checkpoint-every seconds, and at the end (default on a stop:
+    /// OUTFILE.cndl).
+    #[arg(long)]
+    pub checkpoint: Option<PathBuf>,
+    /// Write a checkpoint this often (seconds).
+    #[arg(long, value_parser = parse_seconds)]
+    pub checkpoint_every: Option<f64>,
+    /// Continue the render whose state is in this checkpoint (same scene and flags).
+    #[arg(long)]
+    pub resume: Option<PathBuf>,
+    /// Render whole passes until this many seconds are spent.
+    #[arg(long, value_parser = parse_seconds)]
+    pub time_limit: Option<f64>,
+    /// Stop once the relative standard error of the image mean (every
+    /// channel, from the spread of the per-pass means) is below this.
+    #[arg(long, value_parser = parse_error)]
+    pub target_error: Option<f64>,
+}
+
+impl RenderArgs {
+    /// The command-line values that override the scene file.
+    pub fn overrides(&self) -> Overrides {
+        Overrides {
+            spp: self.spp,
+            integrator: self.integrator.clone(),
+            outfile: self.outfile.clone(),
+            seed: self.seed,
+        }
+    }
+}
+
+/// The settings of `ov` that decide a render's passes, as `key=value` lines.
+fn settings_text(ov: &Overrides) -> String {
+    let mut s = String::new();
+    if let Some(v) = ov.spp {
+        s.push_str(&format!("spp={v}\n"));
+    }
+    if let Some(v) = &ov.integrator {
+        s.push_str(&format!("integrator={v}\n"));
+    }
+    if let Some(v) = ov.seed {
+        s.push_str(&format!("seed={v}\n"));
+    }
+    s
+}
+
+/// The overrides stored by [`settings_text`].
+fn overrides_from(text: &str) -> Result<Overrides> {
+    let mut ov = Overrides::default();
+    for line in text.lines() {
+        let (k, v) = line
+            .split_once('=')
+            .context("malformed settings in the state file")?;
+        match k {
+            "spp" => ov.spp = Some(v.parse().context("spp in the state file")?),
+            "integrator" => ov.integrator = Some(v.to_string()),
+            "seed" => ov.seed = Some(v.parse().context("seed in the state file")?),
+            _ => bail!("unknown setting {k:?} in the state file"),
+        }
+    }
+    Ok(ov)
+}
+
+/// Raises the returned flag on SIGINT, SIGTERM and SIGHUP; a second signal
+/// exits at once.
+fn stop_flag() -> Result<Arc<AtomicBool>> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM, SIGHUP] {
+        signal_hook::flag::register_conditional_shutdown(sig, EXIT_INTERRUPTED, flag.clone())
+            .context("installing signal handlers")?;
+        signal_hook::flag::register(sig, flag.clone()).context("installing signal handlers")?;
+    }
+    Ok(flag)
+}
+
+/// Strategy image names of a film with `n` strategy layers.
+fn strategy_names(setup: &RenderSetup) -> Vec<Option<String>> {
+    let n = setup.film.layout().strategies;
+    (0..64u32)
+        .find(|&d| Visualize::strategy_count(d) == n)
+        .map(Visualize::file_names)
+        .unwrap_or_default()
+}
+
+/// Develops `state` and writes the image files.
+fn write_image(setup: &RenderSetup, state: &RenderState, exr: &Path) -> Result<()> {
+    let overlay = setup
+        .integrator
+        .develop_overlay(&state.integrator_state, state.film.passes().count());
+    let dev = develop(&setup.film, &state.film, overlay.as_deref());
+    output::write(&dev, exr, &strategy_names(setup))
+}
+
+/// `candela render`; returns the exit code.
+pub fn render(args: RenderArgs) -> Result<i32> {
+    if let Some(n) = args.nthreads {
+        if n == 0 {
+            bail!("--nthreads must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("setting up the thread pool")?;
+    }
+    let stop = stop_flag()?;
+    let t0 = Instant::now();
+    let ov = args.overrides();
+    let desc = candela_scene::parse_file(&args.scene)?;
+    let setup = build(&desc, &ov)?;
+    for w in &setup.warnings {
+        eprintln!("candela: warning: {w}");
+    }
+    let exr = output::exr_path(&setup.outfile)?;
+    output::check_writable(&exr)?;
+    let total = setup.sampler.samples_per_pixel() as u64;
+    let passes = args.pass_range.unwrap_or((0, total));
+    if passes.1 > total {
+        bail!(
+            "--pass-range {}..{} goes past the {total} passes of the render (set --spp)",
+            passes.0,
+            passes.1
+        );
+    }
+    let kind = setup.integrator.kind();
+    if args.pass_range.is_some() && !kind.independent_passes() {
+        bail!("--pass-range: {kind}'s passes depend on each other and cannot be split (use ppm, or --checkpoint and --resume)");
+    }
+    let fp = render::fingerprint(&desc, &ov, setup.film.layout());
+    let mut state = match &args.resume {
+        Some(path) => resumed(path, fp, total, kind)?,
+        None => render::new_state(&setup, fp, total, &settings_text(&ov)),
+    };
+    let partial = args.pass_range.map(|(a, b)| {
+        args.checkpoint
+            .clone()
+            .unwrap_or_else(|| exr.with_extension(format!("passes-{a}-{b}.cndl")))
+    });
+    let checkpoint = partial
+        .clone()
+        .or_else(|| args.checkpoint.clone())
+        .unwrap_or_else(|| exr.with_extension("cndl"));
+    let opts = RenderOptions {
+        passes,
+        time_limit: args.time_limit.map(Duration::from_secs_f64),
+        target_error: args.target_error,
+        checkpoint: Some(checkpoint.clone()),
+        checkpoint_every: args.checkpoint_every.map(Duration::from_secs_f64),
+    };
+    let load_time = t0.elapsed();
+    let display = progress::display(args.quiet);
+    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |_| {})?;
+    write_image(&setup, &state, &exr)?;
+    let stopped_early = outcome.reason != StopReason::Finished;
+    let write_state = partial.is_some() || args.checkpoint.is_some() || stopped_early;
+    if write_state {
+        state.save(&checkpoint)?;
+    }
+    if state.film.dropped() > 0 {
+        eprintln!(
+            "candela: warning: {} non-finite samples were dropped (a bug: please report)",
+            state.film.dropped()
+        );
+    }
+    report(
+        &args,
+        &setup,
+        &state,
+        &outcome,
+        load_time,
+        &exr,
+        write_state.then_some(&checkpoint),
+    );
+    Ok(
+        if outcome.reason == StopReason::Interrupted || stop.load(Ordering::Relaxed) {
+            EXIT_INTERRUPTED
+        } else {
+            0
+        },
+    )
+}
+
+/// The state in checkpoint `path`, checked against this render.
+fn resumed(path: &Path, fp: u64, total: u64, kind: IntegratorKind) -> Result<RenderState> {
+    let state = RenderState::load(path).with_context(|| "--resume".to_string())?;
+    if state.fingerprint != fp || state.integrator != kind.name() {
+        bail!(
+            "--resume {}: the checkpoint is of another scene or other settings (same scene file, files and flags needed)",
+            path.display()
+        );
+    }
+    if state.total_passes != total {
+        bail!(
+            "--resume {}: the checkpoint was planned with {} passes, this render with {total}",
+            path.display(),
+            state.total_passes
+        );
+    }
+    Ok(state)
+}
+
+/// The closing line on stderr.
+fn report(
+    args: &RenderArgs,
+    setup: &RenderSetup,
+    state: &RenderState,
+    outcome: &render::Outcome,
+    load: Duration,
+    exr: &Path,
+    checkpoint: Option<&PathBuf>,
+) {
+    if args.quiet {
+        return;
+    }
+    let why = match outcome.reason {
+        StopReason::Finished => String::new(),
+        StopReason::Interrupted => " (interrupted)".into(),
+        StopReason::TimeLimit => " (time limit)".into(),
+        StopReason::TargetError(e) => format!(" (relative error {e:.2e} reached)"),
+    };
+    eprintln!(
+        "candela: {} with {} of {} passes{why}: load {:.2} s, render {:.2} s; wrote {}{}",
+        setup.integrator.kind(),
+        state.film.passes().count(),
+        state.total_passes,
+        load.as_secs_f64(),
+        outcome.elapsed.as_secs_f64(),
+        exr.display(),
+        checkpoint.map_or(String::new(), |c| format!(" and {}", c.display()))
+    );
+}
+
+/// `candela merge` flags.
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// The scene the parts were rendered from.
+    pub scene: PathBuf,
+    /// Partial renders (.cndl state files) with disjoint pass ranges.
+    #[arg(required = true)]
+    pub parts: Vec<PathBuf>,
+    /// Output EXR path (a PNG is written beside it).
+    #[arg(long, short)]
+    pub outfile: PathBuf,
+    /// Also write the merged state here (to merge or resume it further).
+    #[arg(long)]
+    pub checkpoint: Option<PathBuf>,
+}
+
+/// `candela merge`.
+pub fn merge(args: MergeArgs) -> Result<()> {
+    let exr = output::exr_path(&args.outfile)?;
+    output::check_writable(&exr)?;
+    let mut states = args
+        .parts
+        .iter()
+        .map(|p| RenderState::load(p).map_err(anyhow::Error::from));
+    let mut total = states.next().context("no parts to merge")??;
+    for (s, path) in states.zip(args.parts.iter().skip(1)) {
+        total
+            .merge(&s?)
+            .with_context(|| format!("merging {}", path.display()))?;
+    }
+    let ov = overrides_from(&total.settings)?;
+    let desc = candela_scene::parse_file(&args.scene)?;
+    let setup = build(&desc, &ov)?;
+    if render::fingerprint(&desc, &ov, setup.film.layout()) != total.fingerprint {
+        bail!(
+            "the parts were not rendered from {} as it is now (the scene or a file it uses changed)",
+            args.scene.display()
+        );
+    }
+    write_image(&setup, &total, &exr)?;
+    if let Some(c) = &args.checkpoint {
+        total.save(c)?;
+    }
+    eprintln!(
+        "candela: merged passes {} into {}",
+        total.film.passes(),
+        exr.display()
+    );
+    Ok(())
+}
