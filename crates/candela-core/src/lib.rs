@@ -7,6 +7,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod display;
 pub mod film;
 pub mod image;
 pub mod integrator;
