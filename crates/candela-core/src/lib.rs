@@ -8,6 +8,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod build;
 pub mod camera;
+pub mod display;
 pub mod film;
 pub mod image;
 pub mod integrator;

@@ -2,13 +2,20 @@
 //! comparison metrics of `candela diff`, validation.md "Image metrics"), and
 //! map images read for textures and environment lights ([`MapImage`]).
 
+pub mod atomic;
 mod compare;
+pub mod exr_write;
 mod map;
 mod pyramid;
 mod read;
 mod resize;
 
+pub use atomic::{write_atomic, write_atomic_bytes};
 pub use compare::{compare, Comparison};
+pub use exr_write::{
+    encode_exr_layers, read_exr_layers, write_exr_layers, ExrAttribute, ExrAttributes, ExrChannel,
+    ExrImage, ExrLayer,
+};
 pub use map::{MapImage, PixelFormat, WrapMode};
 pub use pyramid::MipPyramid;
 pub use read::{read_map, ColorEncoding, MapFile};
@@ -35,6 +42,14 @@ pub enum ImageError {
         path: String,
         /// Cause.
         source: image::ImageError,
+    },
+    /// Writing the file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// File.
+        path: String,
+        /// Cause.
+        source: std::io::Error,
     },
     /// The file is not a map candela can read.
     #[error("{path}: {msg}")]
@@ -94,21 +109,23 @@ impl RgbImage {
         Ok(img.layer_data.channel_data.pixels)
     }
 
-    /// Writes a 32-bit float RGB EXR.
+    /// Writes a 32-bit float RGB EXR, atomically and with the same bytes for
+    /// the same pixels ([`write_exr_layers`]).
     pub fn write_exr(&self, path: &Path) -> Result<(), ImageError> {
-        exr::prelude::write_rgb_file(path, self.width, self.height, |x, y| {
-            let p = self.get(x, y);
-            (p[0], p[1], p[2])
-        })
-        .map_err(|source| ImageError::Exr {
-            path: path.display().to_string(),
-            source,
-        })
+        let layers = [ExrLayer::from_rgb("", self)];
+        write_exr_layers(
+            path,
+            self.width,
+            self.height,
+            &layers,
+            &ExrAttributes::new(),
+        )
     }
 
-    /// Writes an 8-bit sRGB PNG: linear values scaled by 2^`stops`, clipped
-    /// to [0, 1] and encoded with the sRGB transfer curve.
+    /// Writes an 8-bit sRGB PNG, atomically: linear values scaled by
+    /// 2^`stops`, clipped to [0, 1] and encoded with the sRGB transfer curve.
     pub fn write_png(&self, path: &Path, stops: f32) -> Result<(), ImageError> {
+        use image::ImageEncoder;
         let scale = 2f32.powf(stops);
         let mut buf = Vec::with_capacity(self.width * self.height * 3);
         for p in &self.pixels {
@@ -116,15 +133,21 @@ impl RgbImage {
                 buf.push((srgb_encode(c * scale) * 255.0 + 0.5) as u8);
             }
         }
-        image::save_buffer(
-            path,
-            &buf,
-            self.width as u32,
-            self.height as u32,
-            image::ColorType::Rgb8,
-        )
-        .map_err(|source| ImageError::Png {
-            path: path.display().to_string(),
+        let name = || path.display().to_string();
+        let mut png = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut png)
+            .write_image(
+                &buf,
+                self.width as u32,
+                self.height as u32,
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(|source| ImageError::Png {
+                path: name(),
+                source,
+            })?;
+        write_atomic_bytes(path, &png).map_err(|source| ImageError::Io {
+            path: name(),
             source,
         })
     }
@@ -207,7 +230,12 @@ mod tests {
         let path = dir.join("t.exr");
         img.write_exr(&path).unwrap();
         assert_eq!(RgbImage::read_exr(&path).unwrap(), img);
-        img.write_png(&dir.join("t.png"), 0.0).unwrap();
+        img.write_png(&dir.join("t.png"), -20.0).unwrap();
+        let png = image::open(dir.join("t.png")).unwrap().into_rgb8();
+        for (p, q) in img.pixels.iter().zip(png.pixels()) {
+            let want = p.map(|c| (srgb_encode(c * 2f32.powi(-20)) * 255.0 + 0.5) as u8);
+            assert_eq!(q.0, want);
+        }
         std::fs::remove_dir_all(&dir).ok();
     }
 
