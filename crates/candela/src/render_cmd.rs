@@ -180,7 +180,8 @@ fn write_image(setup: &RenderSetup, state: &RenderState, exr: &Path) -> Result<(
         .integrator
         .develop_overlay(&state.integrator_state, state.film.passes().count());
     let dev = develop(&setup.film, &state.film, overlay.as_deref());
-    output::write(&dev, exr, &strategy_names(setup))
+    let attrs = output::attributes(&dev, &state.integrator, state.total_passes);
+    output::write(&dev, exr, &attrs, &strategy_names(setup))
 }
 
 /// `candela render`; returns the exit code.

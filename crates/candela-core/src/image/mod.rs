@@ -180,27 +180,6 @@ impl RgbImage {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory
-/// that is flushed, synced and renamed over `path`, so a crash or a kill
-/// during the write never leaves a partial file where the previous one was.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-    let name = path.file_name().unwrap_or_default().to_string_lossy();
-    let tmp_name = format!(".{name}.tmp-{}", std::process::id());
-    let tmp = dir.map_or_else(|| Path::new(&tmp_name).to_path_buf(), |d| d.join(&tmp_name));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
 /// sRGB opto-electronic transfer function of a linear value, clipped to [0, 1].
 pub fn srgb_encode(v: f32) -> f32 {
     let v = if v.is_finite() {

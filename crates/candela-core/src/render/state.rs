@@ -168,7 +168,7 @@ impl RenderState {
 
     /// Writes the state to `path` atomically (temporary file, then rename).
     pub fn save(&self, path: &Path) -> Result<(), StateError> {
-        crate::image::write_atomic(path, &self.to_bytes()).map_err(|source| StateError::Io {
+        crate::image::write_atomic_bytes(path, &self.to_bytes()).map_err(|source| StateError::Io {
             path: path.display().to_string(),
             source,
         })
