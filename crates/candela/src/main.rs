@@ -4,7 +4,7 @@
 mod progress;
 
 use anyhow::{bail, Context, Result};
-use candela_core::image::{compare, RgbImage};
+use candela_core::image::{compare, non_finite, RgbImage};
 use candela_core::integrator::sppm::PpmPartial;
 use candela_core::integrator::RenderContext;
 use candela_core::scene::build::{build, summarize, Overrides};
@@ -106,14 +106,56 @@ struct RenderArgs {
     /// Parse and build the scene, print what `candela info` prints, and stop.
     #[arg(long)]
     check_only: bool,
+    /// Render only the part x0 ≤ x < x1, y0 ≤ y < y1 of the image, in [0, 1]
+    /// fractions of the film ("x0,x1,y0,y1", pbrt-v4's `--cropwindow`);
+    /// overrides the Film's "cropwindow" and "pixelbounds".
+    #[arg(long, value_parser = parse_cropwindow)]
+    cropwindow: Option<[f32; 4]>,
+}
+
+/// Parses "x0,x1,y0,y1" with 0 ≤ x0 < x1 ≤ 1 and 0 ≤ y0 < y1 ≤ 1.
+fn parse_cropwindow(s: &str) -> Result<[f32; 4], String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f32>().map_err(|e| format!("{t:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    let unit = |a: f32, b: f32| (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b) && a < b;
+    match v[..] {
+        [x0, x1, y0, y1] if unit(x0, x1) && unit(y0, y1) => Ok([x0, x1, y0, y1]),
+        _ => Err("expected x0,x1,y0,y1 in [0, 1] with x0 < x1 and y0 < y1".into()),
+    }
+}
+
+/// Replaces the Film's "cropwindow" and "pixelbounds" by `--cropwindow`.
+fn apply_cropwindow(desc: &mut candela_scene::SceneDescription, cw: Option<[f32; 4]>) {
+    use candela_scene::{Entity, Loc, Param, ParamSet, ParamType, ParamValue};
+    let Some(cw) = cw else { return };
+    let film = desc.film.get_or_insert_with(|| Entity {
+        name: "rgb".into(),
+        params: ParamSet::default(),
+        color_space: "srgb".into(),
+        loc: Loc::file_only(Path::new("--cropwindow")),
+    });
+    let params = &mut film.params.params;
+    params.retain(|p| p.name != "cropwindow" && p.name != "pixelbounds");
+    params.push(Param {
+        name: "cropwindow".into(),
+        ty: ParamType::Float,
+        value: ParamValue::Floats(cw.to_vec()),
+        loc: Loc::file_only(Path::new("--cropwindow")),
+        used: Default::default(),
+        may_be_unused: false,
+    });
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
-        Cmd::Render(args) if args.check_only => info(&args.scene, &overrides(&args)),
+        Cmd::Render(args) if args.check_only => {
+            info(&args.scene, &overrides(&args), args.cropwindow)
+        }
         Cmd::Render(args) => render(args),
-        Cmd::Info { scene } => info(&scene, &Overrides::default()),
+        Cmd::Info { scene } => info(&scene, &Overrides::default(), None),
         Cmd::Diff { a, b, region } => diff(&a, &b, region),
         Cmd::Merge {
             scene,
@@ -138,7 +180,8 @@ fn render(args: RenderArgs) -> Result<()> {
             .context("setting up the thread pool")?;
     }
     let t0 = Instant::now();
-    let desc = candela_scene::parse_file(&args.scene)?;
+    let mut desc = candela_scene::parse_file(&args.scene)?;
+    apply_cropwindow(&mut desc, args.cropwindow);
     let mut setup = build(&desc, &overrides(&args))?;
     for w in &setup.warnings {
         eprintln!("candela: warning: {w}");
@@ -192,9 +235,10 @@ fn overrides(args: &RenderArgs) -> Overrides {
 }
 
 /// Parses and builds `scene`, then prints its summary and load times.
-fn info(scene: &Path, ov: &Overrides) -> Result<()> {
+fn info(scene: &Path, ov: &Overrides, cropwindow: Option<[f32; 4]>) -> Result<()> {
     let t0 = Instant::now();
-    let desc = candela_scene::parse_file(scene)?;
+    let mut desc = candela_scene::parse_file(scene)?;
+    apply_cropwindow(&mut desc, cropwindow);
     let parsed = t0.elapsed();
     let setup = build(&desc, ov)?;
     let total = t0.elapsed();
@@ -284,6 +328,21 @@ fn diff(a: &Path, b: &Path, region: Option<[usize; 4]>) -> Result<()> {
         ib = ib
             .crop(r)
             .with_context(|| format!("region outside {}", b.display()))?;
+    }
+    let mut bad = Vec::new();
+    for (img, path) in [(&ia, a), (&ib, b)] {
+        if let Some(nf) = non_finite(img) {
+            bad.push(format!(
+                "{}: {} non-finite (NaN or infinite) pixels, the first at ({}, {})",
+                path.display(),
+                nf.count,
+                nf.first.0,
+                nf.first.1
+            ));
+        }
+    }
+    if !bad.is_empty() {
+        bail!("{}", bad.join("; "));
     }
     let c = compare(&ia, &ib)?;
     let (ma, mb) = (ia.channel_means(), ib.channel_means());

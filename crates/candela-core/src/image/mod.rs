@@ -8,7 +8,7 @@ mod pyramid;
 mod read;
 mod resize;
 
-pub use compare::{compare, Comparison};
+pub use compare::{compare, non_finite, Comparison, NonFinite};
 pub use map::{MapImage, PixelFormat, WrapMode};
 pub use pyramid::MipPyramid;
 pub use read::{read_map, ColorEncoding, MapFile};
@@ -18,23 +18,28 @@ use std::path::Path;
 use thiserror::Error;
 
 /// Failure reading or writing an image file.
+///
+/// The codec's error is printed in the message and deliberately not chained
+/// as a `source()`: the codecs' errors chain their I/O error in turn, so an
+/// error reporter walking the chain (`anyhow`'s `{:#}`) would print the same
+/// "No such file or directory" three times.
 #[derive(Debug, Error)]
 pub enum ImageError {
     /// The EXR codec failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Exr {
         /// File.
         path: String,
         /// Cause.
-        source: exr::error::Error,
+        error: exr::error::Error,
     },
     /// The PNG codec failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Png {
         /// File.
         path: String,
         /// Cause.
-        source: image::ImageError,
+        error: image::ImageError,
     },
     /// The file is not a map candela can read.
     #[error("{path}: {msg}")]
@@ -87,9 +92,9 @@ impl RgbImage {
                 img.pixels[pos.y() * w + pos.x()] = [r, g, b];
             },
         )
-        .map_err(|source| ImageError::Exr {
+        .map_err(|error| ImageError::Exr {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         Ok(img.layer_data.channel_data.pixels)
     }
@@ -100,9 +105,9 @@ impl RgbImage {
             let p = self.get(x, y);
             (p[0], p[1], p[2])
         })
-        .map_err(|source| ImageError::Exr {
+        .map_err(|error| ImageError::Exr {
             path: path.display().to_string(),
-            source,
+            error,
         })
     }
 
@@ -123,9 +128,9 @@ impl RgbImage {
             self.height as u32,
             image::ColorType::Rgb8,
         )
-        .map_err(|source| ImageError::Png {
+        .map_err(|error| ImageError::Png {
             path: path.display().to_string(),
-            source,
+            error,
         })
     }
 
