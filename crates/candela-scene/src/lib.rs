@@ -32,6 +32,7 @@ mod world;
 
 use std::path::Path;
 
+pub use builder::{MAX_BLOCK_DEPTH, MAX_COPIED_VALUES};
 pub use desc::{
     CameraDesc, Entity, InstanceDefinition, InstanceUse, LightDesc, MaterialDesc, MaterialRef,
     SceneDescription, ShapeDesc, TextureDesc, TextureKind,

@@ -139,9 +139,9 @@ impl Parser {
         let b = &mut self.b;
         match name {
             b"Identity" => b.apply(|_| Mat4d::IDENTITY),
-            b"AttributeBegin" => b.push(Block::Attribute, loc),
+            b"AttributeBegin" => b.push(Block::Attribute, loc)?,
             b"AttributeEnd" => b.pop(Block::Attribute, "AttributeEnd", loc)?,
-            b"TransformBegin" => b.transform_begin(loc),
+            b"TransformBegin" => b.transform_begin(loc)?,
             b"TransformEnd" => b.pop(Block::Attribute, "TransformEnd", loc)?,
             b"ReverseOrientation" => b.reverse_orientation(),
             b"WorldBegin" => b.world_begin(loc)?,
@@ -474,7 +474,7 @@ impl Parser {
         }
         let text = read_scene_file(&path, loc)?;
         if import {
-            self.b.push(Block::Import, loc);
+            self.b.push(Block::Import, loc)?;
         }
         self.files.push(Source {
             lexer: Lexer::new(text, Arc::from(path.as_path())),

@@ -140,3 +140,58 @@ fn invalid_utf8_and_giant_numbers_are_clean() {
     let long = format!("WorldBegin\nTranslate {} 0 0\n", "9".repeat(100_000));
     assert!(parse_str(&long, p).is_ok());
 }
+
+#[test]
+fn deep_block_nesting_is_a_located_error() {
+    let text = format!(
+        "WorldBegin\n{}",
+        "AttributeBegin\n".repeat(MAX_BLOCK_DEPTH + 1)
+    );
+    let e = parse_str(&text, Path::new("t.pbrt"))
+        .unwrap_err()
+        .to_string();
+    let line = MAX_BLOCK_DEPTH + 2;
+    assert_eq!(
+        e,
+        format!("t.pbrt:{line}:1: blocks nested deeper than {MAX_BLOCK_DEPTH}")
+    );
+}
+
+#[test]
+fn copying_large_attributes_into_many_entities_stops_at_the_budget() {
+    // One Attribute of 2^20 values copied into 100 shapes would be 10^8
+    // values; the budget stops it at about 64 shapes (~260 MB), and the
+    // error names the shape that crossed it.
+    let values = " 1".repeat(1 << 20);
+    let text = format!(
+        "WorldBegin\nAttribute \"shape\" \"float junk\" [{values}]\n{}",
+        "Shape \"sphere\"\n".repeat(100)
+    );
+    let e = parse_str(&text, Path::new("t.pbrt"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("copies more than"), "{e}");
+    let line: usize = e.split(':').nth(1).unwrap().parse().unwrap();
+    let shapes = (line - 2) as u64;
+    let per_shape = (1u64 << 20) + 1;
+    assert_eq!(shapes, MAX_COPIED_VALUES / per_shape + 1, "{e}");
+    // Area-light parameters copied into shapes count too, and so does the
+    // state saved by AttributeBegin.
+    let text = format!(
+        "WorldBegin\nAreaLightSource \"diffuse\" \"float junk\" [{values}]\n{}",
+        "AttributeBegin\n".repeat(100)
+    );
+    let e = parse_str(&text, Path::new("t.pbrt"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("copies more than"), "{e}");
+    // Ordinary use stays far below: a default copied into 10^5 shapes.
+    let text = format!(
+        "WorldBegin\nAttribute \"shape\" \"float alpha\" [1]\n{}",
+        "Shape \"sphere\"\n".repeat(100_000)
+    );
+    assert_eq!(
+        parse_str(&text, Path::new("t.pbrt")).unwrap().shapes.len(),
+        100_000
+    );
+}
