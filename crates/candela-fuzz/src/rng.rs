@@ -32,7 +32,7 @@ impl Rng {
             return 0;
         }
         // Lemire's multiply-shift; the bias is below 2^-32 for our n.
-        ((self.next_u64() >> 32) * n as u64 >> 32) as usize
+        (((self.next_u64() >> 32) * n as u64) >> 32) as usize
     }
 
     /// True with probability `p`.

@@ -14,11 +14,13 @@
 //! panic; death by a signal (SIGABRT after "has overflowed its stack",
 //! SIGSEGV) → abort; exit 0 → ok; any other exit with a
 //! `candela: error:` message → clean error; anything else → abort.
+//! Hangs are rerun with `--check-only`, so their signature says whether
+//! parsing and building or rendering hangs.
 
 use std::io::Read;
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -117,8 +119,37 @@ pub fn candela_args(scene: &str, crop: [f32; 4]) -> Vec<String> {
 }
 
 impl Runner {
-    /// Runs `candela` with `args` in `dir` under the limits.
+    /// Runs `candela` with `args` in `dir` under the limits. A case that
+    /// hangs is run again with `--check-only` (parse and build, no render)
+    /// to tell which phase hangs: its signature says which.
     pub fn run(&self, dir: &Path, args: &[String]) -> Result<RunResult> {
+        let (status, stderr) = self.spawn(dir, args)?;
+        let (outcome, mut signature) = classify(status, &stderr);
+        if outcome == Outcome::Hang {
+            let mut check = args.to_vec();
+            check.push("--check-only".into());
+            let (again, _) = self.spawn(dir, &check)?;
+            signature += if again.is_none() {
+                " in parse/build"
+            } else {
+                " while rendering"
+            };
+        }
+        let located = outcome == Outcome::CleanError && has_location(&stderr);
+        Ok(RunResult {
+            outcome,
+            signature,
+            located,
+            stderr,
+            command: std::iter::once("candela".to_string())
+                .chain(args.iter().cloned())
+                .collect(),
+        })
+    }
+
+    /// Runs the child once: its exit status (`None`: killed at the time
+    /// limit) and stderr.
+    fn spawn(&self, dir: &Path, args: &[String]) -> Result<(Option<ExitStatus>, String)> {
         let err_path = dir.join("fuzz_stderr.txt");
         let err_file = std::fs::File::create(&err_path)
             .with_context(|| format!("creating {}", err_path.display()))?;
@@ -150,18 +181,7 @@ impl Runner {
             std::thread::sleep(nap);
             nap = (nap * 2).min(Duration::from_millis(20));
         };
-        let stderr = read_capped(&err_path, 64 << 10);
-        let (outcome, signature) = classify(status, &stderr);
-        let located = outcome == Outcome::CleanError && has_location(&stderr);
-        Ok(RunResult {
-            outcome,
-            signature,
-            located,
-            stderr,
-            command: std::iter::once("candela".to_string())
-                .chain(args.iter().cloned())
-                .collect(),
-        })
+        Ok((status, read_capped(&err_path, 64 << 10)))
     }
 }
 
@@ -175,13 +195,19 @@ fn read_capped(path: &Path, cap: u64) -> String {
 }
 
 /// The class and signature of an exit `status` (`None`: timed out).
-pub fn classify(status: Option<std::process::ExitStatus>, stderr: &str) -> (Outcome, String) {
+pub fn classify(status: Option<ExitStatus>, stderr: &str) -> (Outcome, String) {
     let Some(status) = status else {
         return (Outcome::Hang, "time limit".into());
     };
     let line = |pat: &str| stderr.lines().find(|l| l.contains(pat)).map(str::to_string);
     if let Some(l) = line("memory allocation of") {
-        return (Outcome::MemoryLimit, l);
+        // The size in orders of magnitude: 137438945280 -> "~1e11".
+        let digits = l.split_whitespace().nth(3).map_or(0, str::len);
+        let sig = format!(
+            "memory allocation of ~1e{} bytes failed",
+            digits.saturating_sub(1)
+        );
+        return (Outcome::MemoryLimit, sig);
     }
     if let Some(i) = stderr.find("panicked at") {
         // "thread 'main' panicked at src/x.rs:1:2:\nmessage\nstack backtrace: ..."
@@ -310,8 +336,9 @@ mod tests {
         assert_eq!(o, Outcome::Abort);
         assert_eq!(s, "signal 6: stack overflow");
         let oom = "memory allocation of 80000000000 bytes failed\n";
-        let (o, _) = classify(Some(std::process::ExitStatus::from_raw(6)), oom);
+        let (o, s) = classify(Some(std::process::ExitStatus::from_raw(6)), oom);
         assert_eq!(o, Outcome::MemoryLimit);
+        assert_eq!(s, "memory allocation of ~1e10 bytes failed");
         assert_eq!(classify(None, "").0, Outcome::Hang);
         assert_eq!(classify(exit(0), "").0, Outcome::Ok);
         assert_eq!(
@@ -319,6 +346,34 @@ mod tests {
             Outcome::CleanError
         );
         assert_eq!(classify(exit(1), "").0, Outcome::Abort);
+    }
+
+    #[test]
+    fn hangs_are_killed_and_their_phase_found() {
+        let dir = std::env::temp_dir().join(format!("candela-fuzz-run-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let runner = |prog: &str| Runner {
+            candela: prog.into(),
+            timeout: Duration::from_millis(300),
+            mem_mib: 1024,
+        };
+        let args = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let t = Instant::now();
+        // `sleep 30 --check-only` fails at once: only the render hangs.
+        let r = runner("/bin/sleep").run(&dir, &args(&["30"])).unwrap();
+        assert_eq!(
+            (r.outcome, r.signature.as_str()),
+            (Outcome::Hang, "time limit while rendering")
+        );
+        // `sh -c 'exec sleep 30' --check-only` sleeps too: parse/build hangs
+        // (exec, so that the kill reaches the sleep itself).
+        let r = runner("/bin/sh")
+            .run(&dir, &args(&["-c", "exec sleep 30"]))
+            .unwrap();
+        assert_eq!(r.signature, "time limit in parse/build");
+        assert!(t.elapsed() < Duration::from_secs(10), "{:?}", t.elapsed());
+        let r = runner("/bin/sh").run(&dir, &args(&["-c", "echo 'candela: error: x' >&2; exit 1"]));
+        assert_eq!(r.unwrap().outcome, Outcome::CleanError);
     }
 
     #[test]
