@@ -10,13 +10,14 @@
 //! needs a look, with a replay script).
 //!
 //! Layout: `rng` (SplitMix64, one stream per case), `corpus` (seeds),
-//! `tokens`, `mutate`, `run`, `campaign`, `known` (the allow-list of
+//! `tokens`, `mutate` (scene text), `ply_mutate`, `run`, `campaign`, `known` (the allow-list of
 //! findings already reported, `findings/known.txt`).
 
 pub mod campaign;
 pub mod corpus;
 pub mod known;
 pub mod mutate;
+pub mod ply_mutate;
 pub mod rng;
 pub mod run;
 pub mod tokens;

@@ -167,7 +167,7 @@ impl Runner {
             .spawn()
             .with_context(|| format!("starting {}", self.candela.display()))?;
         let start = Instant::now();
-        let mut nap = Duration::from_millis(1);
+        let mut nap = Duration::from_micros(250);
         let status = loop {
             if let Some(s) = child.try_wait()? {
                 break Some(s);
@@ -179,7 +179,7 @@ impl Runner {
                 break None;
             }
             std::thread::sleep(nap);
-            nap = (nap * 2).min(Duration::from_millis(20));
+            nap = (nap * 2).min(Duration::from_millis(2));
         };
         Ok((status, read_capped(&err_path, 64 << 10)))
     }
