@@ -64,6 +64,8 @@ fn main() -> Result<()> {
         "no candela binary at {}",
         candela.display()
     );
+    // Cases run in their own directories: a relative path would not resolve.
+    let candela = std::fs::canonicalize(&candela)?;
     let cfg = Config {
         scenes: a.scenes,
         out: a.out,

@@ -124,6 +124,10 @@ impl Runner {
     /// to tell which phase hangs: its signature says which.
     pub fn run(&self, dir: &Path, args: &[String]) -> Result<RunResult> {
         let (status, stderr) = self.spawn(dir, args)?;
+        // 126/127: the shell could not run the program at all.
+        if let Some(c @ (126 | 127)) = status.and_then(|s| s.code()) {
+            anyhow::bail!("cannot run {} (exit {c}): {stderr}", self.candela.display());
+        }
         let (outcome, mut signature) = classify(status, &stderr);
         if outcome == Outcome::Hang {
             let mut check = args.to_vec();
