@@ -329,6 +329,8 @@ fn diff(a: &Path, b: &Path, region: Option<[usize; 4]>) -> Result<()> {
             .crop(r)
             .with_context(|| format!("region outside {}", b.display()))?;
     }
+    // Positions are reported in the full image, not in the region.
+    let (x0, y0) = region.map_or((0, 0), |r| (r[0], r[1]));
     let mut bad = Vec::new();
     for (img, path) in [(&ia, a), (&ib, b)] {
         if let Some(nf) = non_finite(img) {
@@ -336,8 +338,8 @@ fn diff(a: &Path, b: &Path, region: Option<[usize; 4]>) -> Result<()> {
                 "{}: {} non-finite (NaN or infinite) pixels, the first at ({}, {})",
                 path.display(),
                 nf.count,
-                nf.first.0,
-                nf.first.1
+                x0 + nf.first.0,
+                y0 + nf.first.1
             ));
         }
     }

@@ -140,6 +140,15 @@ fn diff_reports_non_finite_pixels_and_fails() {
     // Both sides are checked, and finite images still compare.
     let err = clean_error(&candela(&["diff", "b.exr", "a.exr"], &d));
     assert!(err.contains("a.exr: 2 non-finite"), "{err}");
+    // In a region, positions stay those of the full image.
+    let err = clean_error(&candela(
+        &["diff", "a.exr", "b.exr", "--region", "4,1,8,4"],
+        &d,
+    ));
+    assert!(
+        err.contains("a.exr: 1 non-finite (NaN or infinite) pixels, the first at (6, 2)"),
+        "{err}"
+    );
     let o = candela(&["diff", "b.exr", "b.exr"], &d);
     assert!(o.status.success());
 }
