@@ -9,6 +9,14 @@
 //! [`SceneDescription`]. Cross-references that pbrt-v4 resolves after
 //! parsing (named materials, object instances) are checked in
 //! [`Builder::finish`].
+//!
+//! Snapshots copy parameters: `Attribute` defaults go into every later
+//! entity, the area light into every shape, and each `AttributeBegin` saves
+//! a copy of the whole state. A small scene could thus demand memory far
+//! beyond its size (one 10⁶-value `Attribute` followed by 10⁵ shapes is
+//! 10¹¹ copied values). The builder counts the values it copies and stops
+//! past [`MAX_COPIED_VALUES`], and block nesting stops past
+//! [`MAX_BLOCK_DEPTH`]; both are far above what real scenes do.
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -19,6 +27,54 @@ use crate::math::Mat4d;
 use crate::param::{Param, ParamSet};
 
 type Result<T> = std::result::Result<T, SceneError>;
+
+/// Maximum nesting of `AttributeBegin`/`ObjectBegin`/`Import` blocks.
+pub const MAX_BLOCK_DEPTH: usize = 10_000;
+
+/// Maximum number of parameter values (plus a fixed cost per saved state)
+/// that snapshots of the graphics state may copy in one scene.
+pub const MAX_COPIED_VALUES: u64 = 1 << 26;
+
+/// Values copied so far into snapshots of the graphics state.
+#[derive(Debug, Default)]
+pub(crate) struct CopyBudget {
+    copied: u64,
+}
+
+impl CopyBudget {
+    /// Counts `n` more copied values; an error at `loc` past the limit.
+    pub(crate) fn charge(&mut self, n: u64, loc: &Loc) -> Result<()> {
+        self.copied = self.copied.saturating_add(n);
+        if self.copied > MAX_COPIED_VALUES {
+            return Err(SceneError::at(
+                loc,
+                format!(
+                    "the scene copies more than {MAX_COPIED_VALUES} parameter values into its \
+                     entities (large Attribute or AreaLightSource parameters repeated into many \
+                     shapes or nested blocks?)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The number of values in `params` (one at least per parameter), the
+/// unit of [`CopyBudget`].
+pub(crate) fn weight(params: &[Param]) -> u64 {
+    use crate::param::ParamValue as V;
+    use crate::spectrum::SpectrumValue as S;
+    let one = |p: &Param| match &p.value {
+        V::Floats(v) => v.len(),
+        V::Ints(v) => v.len(),
+        V::Bools(v) => v.len(),
+        V::Strings(v) => v.iter().map(|s| 1 + s.len() / 8).sum(),
+        V::Spectrum(S::Sampled(v)) => v.len(),
+        V::Spectrum(S::Named(s)) => 1 + s.len() / 8,
+        V::Spectrum(S::Blackbody(_)) => 1,
+    };
+    params.iter().map(|p| 1 + one(p) as u64).sum()
+}
 
 /// Why a graphics state was pushed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,6 +119,20 @@ pub(crate) struct GraphicsState {
     pub(crate) attributes: Attributes,
 }
 
+impl GraphicsState {
+    /// What saving a copy of this state costs in [`CopyBudget`] units: its
+    /// parameters plus a fixed 64 for the rest (about 500 bytes).
+    fn weight(&self) -> u64 {
+        let a = &self.attributes;
+        let lists = [&a.shape, &a.light, &a.material, &a.medium, &a.texture];
+        let area = self
+            .area_light
+            .as_ref()
+            .map_or(0, |e| weight(&e.params.params));
+        64 + area + lists.iter().map(|l| weight(l)).sum::<u64>()
+    }
+}
+
 impl Default for GraphicsState {
     fn default() -> Self {
         GraphicsState {
@@ -91,6 +161,7 @@ pub(crate) struct Builder {
     pub(crate) material_names: HashSet<String>,
     warned_motion: bool,
     warned_transform_begin: bool,
+    pub(crate) budget: CopyBudget,
 }
 
 impl Builder {
@@ -113,6 +184,7 @@ impl Builder {
             material_names: HashSet::new(),
             warned_motion: false,
             warned_transform_begin: false,
+            budget: CopyBudget::default(),
         }
     }
 
@@ -294,8 +366,16 @@ impl Builder {
     // ---- attribute blocks ---------------------------------------------
 
     /// Saves the graphics state (`AttributeBegin`, `ObjectBegin`, `Import`).
-    pub(crate) fn push(&mut self, block: Block, loc: &Loc) {
+    pub(crate) fn push(&mut self, block: Block, loc: &Loc) -> Result<()> {
+        if self.stack.len() >= MAX_BLOCK_DEPTH {
+            return Err(SceneError::at(
+                loc,
+                format!("blocks nested deeper than {MAX_BLOCK_DEPTH}"),
+            ));
+        }
+        self.budget.charge(self.gs.weight(), loc)?;
         self.stack.push((self.gs.clone(), block, loc.clone()));
+        Ok(())
     }
 
     /// Restores the graphics state saved by the matching `push`.
@@ -318,7 +398,7 @@ impl Builder {
     }
 
     /// `TransformBegin`: deprecated alias of `AttributeBegin` in pbrt-v4.
-    pub(crate) fn transform_begin(&mut self, loc: &Loc) {
+    pub(crate) fn transform_begin(&mut self, loc: &Loc) -> Result<()> {
         if !self.warned_transform_begin {
             self.warned_transform_begin = true;
             self.warn(
@@ -326,7 +406,7 @@ impl Builder {
                 "TransformBegin/End are deprecated; use AttributeBegin/End",
             );
         }
-        self.push(Block::Attribute, loc);
+        self.push(Block::Attribute, loc)
     }
 
     /// `Attribute "target" params`: defaults for later entities.
@@ -357,14 +437,22 @@ impl Builder {
 }
 
 /// `params` preceded by the attribute `defaults` (so `params` win lookups).
-pub(crate) fn with_defaults(defaults: &[Param], params: ParamSet) -> ParamSet {
+/// `params` after the `Attribute` `defaults` (which lose to them), with the
+/// copy charged to `budget`.
+pub(crate) fn with_defaults(
+    defaults: &[Param],
+    params: ParamSet,
+    budget: &mut CopyBudget,
+    loc: &Loc,
+) -> Result<ParamSet> {
     if defaults.is_empty() {
-        return params;
+        return Ok(params);
     }
+    budget.charge(weight(defaults), loc)?;
     let mut all = defaults.to_vec();
     all.extend(params.params);
-    ParamSet {
+    Ok(ParamSet {
         params: all,
         base_dir: params.base_dir,
-    }
+    })
 }

@@ -68,8 +68,9 @@ pub enum SceneError {
     /// A file (scene, Include, spectrum, mesh) could not be read.
     ///
     /// The message already ends with the I/O error, so it is not also
-    /// chained as a `source()` (error reporters would print it twice).
-    #[error("{loc}: cannot read '{}': {error}", path.display())]
+    /// chained as a `source()` (error reporters would print it twice), and
+    /// the location is left out when it is just the file itself.
+    #[error("{}cannot read '{}': {error}", io_prefix(loc, path), path.display())]
     Io {
         /// The directive or parameter that asked for the file, or the file itself.
         loc: Loc,
@@ -113,6 +114,16 @@ impl SceneError {
             | SceneError::Unsupported { loc, .. }
             | SceneError::Io { loc, .. } => loc,
         }
+    }
+}
+
+/// `"loc: "` before an I/O error, or nothing when `loc` only names `path`
+/// (which the message names anyway).
+fn io_prefix(loc: &Loc, path: &Path) -> String {
+    if loc.line == 0 && *loc.file == *path {
+        String::new()
+    } else {
+        format!("{loc}: ")
     }
 }
 

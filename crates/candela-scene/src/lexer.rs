@@ -9,6 +9,8 @@
 //! `\n \t \r \b \f \\ \' \"`), `[` and `]`, `#` comments to the end of the
 //! line (skipped), and "words" — maximal runs of bytes that are not
 //! whitespace, quotes or brackets (directive names, numbers, `true`/`false`).
+//! A UTF-8 byte-order mark at the start of a file (as some Windows editors
+//! write) is skipped; columns on the first line count from after it.
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -61,12 +63,17 @@ pub struct Lexer {
 impl Lexer {
     /// A lexer over `text`, reporting locations in `file`.
     pub fn new(text: Vec<u8>, file: Arc<Path>) -> Lexer {
+        let bom = if text.starts_with(UTF8_BOM) {
+            UTF8_BOM.len()
+        } else {
+            0
+        };
         Lexer {
             text,
             file,
-            pos: 0,
+            pos: bom,
             line: 1,
-            line_start: 0,
+            line_start: bom,
             peeked: None,
         }
     }
@@ -224,6 +231,9 @@ impl Lexer {
     }
 }
 
+/// The UTF-8 encoding of U+FEFF, the byte-order mark.
+const UTF8_BOM: &[u8] = b"\xef\xbb\xbf";
+
 /// Whitespace as pbrt-v4 sees it (newline handled separately).
 fn is_space(b: u8) -> bool {
     matches!(b, b' ' | b'\t' | b'\r' | b'\n' | 0x0b | 0x0c)
@@ -281,6 +291,17 @@ mod tests {
         assert_eq!(t[2].kind, TokenKind::Open);
         assert_eq!((t[2].line, t[2].col), (2, 3));
         assert_eq!(l.bytes(&t[4]), b"-2.5e1");
+    }
+
+    #[test]
+    fn byte_order_mark_is_skipped() {
+        let (l, t) = lex("\u{feff}LookAt 1");
+        assert_eq!(l.bytes(&t[0]), b"LookAt");
+        assert_eq!((t[0].line, t[0].col), (1, 1));
+        assert_eq!((t[1].line, t[1].col), (1, 8));
+        // Only at the start: elsewhere it is part of a word, as before.
+        let (l, t) = lex("a \u{feff}b");
+        assert_eq!(l.bytes(&t[1]), "\u{feff}b".as_bytes());
     }
 
     #[test]

@@ -7,6 +7,7 @@
 //!
 //! Layout:
 //! - `error`: [`Loc`], [`SceneError`], [`Warning`].
+//! - `input`: bounded reads of regular files only (no devices, FIFOs, bombs).
 //! - `lexer`: byte tokenizer with line/column tracking.
 //! - `paramlist`: `"type name" [values]` lists -> [`ParamSet`].
 //! - `param`: [`ParamSet`] and its typed getters; `spectrum`: spectra.
@@ -18,6 +19,7 @@
 mod builder;
 mod desc;
 mod error;
+mod input;
 mod lexer;
 mod math;
 mod param;
@@ -30,14 +32,16 @@ mod world;
 
 use std::path::Path;
 
+pub use builder::{MAX_BLOCK_DEPTH, MAX_COPIED_VALUES};
 pub use desc::{
     fnv1a64, CameraDesc, Entity, InstanceDefinition, InstanceUse, LightDesc, MaterialDesc,
     MaterialRef, SceneDescription, ShapeDesc, SourceFile, TextureDesc, TextureKind,
 };
 pub use error::{Loc, SceneError, Warning};
+pub use input::{MAX_PLY_FILE_BYTES, MAX_SCENE_FILE_BYTES, MAX_SPECTRUM_FILE_BYTES};
 pub use math::Mat4d;
 pub use param::{Param, ParamSet, ParamType, ParamValue};
-pub use parser::MAX_INCLUDE_DEPTH;
+pub use parser::{MAX_INCLUDED_FILES, MAX_INCLUDE_DEPTH};
 pub use ply::{read_ply, MeshData};
 pub use spectrum::{ParamSpectrum, SpectrumValue};
 

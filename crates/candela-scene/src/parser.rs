@@ -7,14 +7,21 @@
 //! file's directory (pbrt-v4's search directory). Nesting deeper than
 //! [`MAX_INCLUDE_DEPTH`] or including a file that is already open is an
 //! error rather than a stack overflow. Files ending in `.gz` are gunzipped.
+//!
+//! Including a file that is not open is allowed any number of times, so a
+//! few small files that each include the next one ten times would expand
+//! exponentially (a "billion laughs"). The parser therefore stops after
+//! [`MAX_INCLUDED_FILES`] `Include`/`Import` directives in one scene; real
+//! scenes use thousands at most. Each file is read through `input`, which
+//! refuses devices, FIFOs and directories and bounds the size.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::builder::{Block, Builder, OptionEntity};
 use crate::desc::SceneDescription;
 use crate::error::{Loc, SceneError};
+use crate::input;
 use crate::lexer::{Lexer, Token, TokenKind};
 use crate::math::Mat4d;
 use crate::param::{resolve_path, ParamSet};
@@ -24,6 +31,9 @@ type Result<T> = std::result::Result<T, SceneError>;
 
 /// Maximum number of files open at once through `Include`/`Import`.
 pub const MAX_INCLUDE_DEPTH: usize = 32;
+
+/// Maximum number of `Include`/`Import` directives followed in one scene.
+pub const MAX_INCLUDED_FILES: usize = 100_000;
 
 /// One open file.
 struct Source {
@@ -40,19 +50,13 @@ struct Parser {
     base_dir: Arc<Path>,
     b: Builder,
     end: Loc,
+    /// `Include`/`Import` directives followed so far.
+    included: usize,
 }
 
 /// Reads a scene file, gunzipping `.gz` files; errors are reported at `loc`.
 pub(crate) fn read_scene_file(path: &Path, loc: &Loc) -> Result<Vec<u8>> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::io(loc, path, e))?;
-    if path.extension().is_some_and(|e| e == "gz") {
-        let mut out = Vec::new();
-        flate2::read::MultiGzDecoder::new(bytes.as_slice())
-            .read_to_end(&mut out)
-            .map_err(|e| SceneError::io(loc, path, e))?;
-        return Ok(out);
-    }
-    Ok(bytes)
+    input::read_file(path, loc, input::MAX_SCENE_FILE_BYTES)
 }
 
 /// Parses scene `text` that claims to live at `path`.
@@ -71,6 +75,7 @@ pub(crate) fn parse_bytes(text: Vec<u8>, path: &Path) -> Result<SceneDescription
         b,
         base_dir,
         end: Loc::file_only(path),
+        included: 0,
     };
     p.run()?;
     let end = p.end.clone();
@@ -136,9 +141,9 @@ impl Parser {
         let b = &mut self.b;
         match name {
             b"Identity" => b.apply(|_| Mat4d::IDENTITY),
-            b"AttributeBegin" => b.push(Block::Attribute, loc),
+            b"AttributeBegin" => b.push(Block::Attribute, loc)?,
             b"AttributeEnd" => b.pop(Block::Attribute, "AttributeEnd", loc)?,
-            b"TransformBegin" => b.transform_begin(loc),
+            b"TransformBegin" => b.transform_begin(loc)?,
             b"TransformEnd" => b.pop(Block::Attribute, "TransformEnd", loc)?,
             b"ReverseOrientation" => b.reverse_orientation(),
             b"WorldBegin" => b.world_begin(loc)?,
@@ -452,6 +457,13 @@ impl Parser {
                 format!("{directive} nesting deeper than {MAX_INCLUDE_DEPTH} files"),
             ));
         }
+        if self.included >= MAX_INCLUDED_FILES {
+            return Err(SceneError::at(
+                loc,
+                format!("more than {MAX_INCLUDED_FILES} Include/Import directives in one scene"),
+            ));
+        }
+        self.included += 1;
         let key = canonical(&path);
         if self.files.iter().any(|f| f.key == key) {
             return Err(SceneError::at(
@@ -465,7 +477,7 @@ impl Parser {
         let text = read_scene_file(&path, loc)?;
         self.b.add_source(&path, &text);
         if import {
-            self.b.push(Block::Import, loc);
+            self.b.push(Block::Import, loc)?;
         }
         self.files.push(Source {
             lexer: Lexer::new(text, Arc::from(path.as_path())),

@@ -11,11 +11,23 @@
 //! The whole file is read into memory and the body decoded by a reader
 //! generic over the encoding, so a binary file decodes with one
 //! `from_le_bytes` per value.
+//!
+//! The reader is strict where a lenient one would silently lose geometry:
+//! the header must declare a `vertex` element with `x y z` and a `face`
+//! element with a vertex index list; a face with fewer than three indices,
+//! an index past the vertex count, and any data left after the last
+//! declared element (apart from trailing whitespace in ASCII files) are
+//! errors. Trailing data almost always means a header count is too small,
+//! which would otherwise shift every later record and read as a mesh with
+//! no triangles. Errors in ASCII bodies name `file:line:col`; in binary
+//! bodies the byte offset in the file. Counts in the header are trusted for
+//! loops only: every record consumes input, so a count larger than the file
+//! ends at "unexpected end" instead of allocating what the header claims.
 
-use std::io::Read;
 use std::path::Path;
 
 use crate::error::{Loc, SceneError};
+use crate::input;
 
 type Result<T> = std::result::Result<T, SceneError>;
 
@@ -91,6 +103,18 @@ struct Element {
     name: String,
     count: usize,
     props: Vec<Property>,
+    /// Header line of the `element` declaration.
+    line: u32,
+}
+
+/// What the header says: encoding, elements and where the body starts.
+struct Header {
+    format: Format,
+    elements: Vec<Element>,
+    /// Byte offset of the body in the file.
+    body_start: usize,
+    /// Line number of `end_header`.
+    lines: u32,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,28 +126,25 @@ enum Format {
 
 /// Reads a PLY file (gunzipping `.gz`) into triangles.
 pub fn read_ply(path: &Path) -> Result<MeshData> {
-    let loc = Loc::file_only(path);
-    let raw = std::fs::read(path).map_err(|e| SceneError::io(&loc, path, e))?;
-    let bytes = if path.extension().is_some_and(|e| e == "gz") {
-        let mut out = Vec::new();
-        flate2::read::MultiGzDecoder::new(raw.as_slice())
-            .read_to_end(&mut out)
-            .map_err(|e| SceneError::io(&loc, path, e))?;
-        out
-    } else {
-        raw
-    };
+    let bytes = input::read_file(path, &Loc::file_only(path), input::MAX_PLY_FILE_BYTES)?;
     parse_ply(&bytes, path)
 }
 
 /// Decodes PLY `bytes`; `path` is used for error locations.
 pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshData> {
-    let (format, elements, body_start) = parse_header(bytes, path)?;
-    let body = bytes.get(body_start..).unwrap_or(&[]);
-    let mut mesh = match format {
-        Format::Ascii => read_body(&mut Ascii::new(body, path), &elements, body.len())?,
-        Format::Little => read_body(&mut Binary::<false>::new(body, path), &elements, body.len())?,
-        Format::Big => read_body(&mut Binary::<true>::new(body, path), &elements, body.len())?,
+    let h = parse_header(bytes, path)?;
+    check_elements(&h, path)?;
+    let body = bytes.get(h.body_start..).unwrap_or(&[]);
+    let mut mesh = match h.format {
+        Format::Ascii => read_body(&mut Ascii::new(body, path, h.lines), &h.elements)?,
+        Format::Little => read_body(
+            &mut Binary::<false>::new(body, path, h.body_start),
+            &h.elements,
+        )?,
+        Format::Big => read_body(
+            &mut Binary::<true>::new(body, path, h.body_start),
+            &h.elements,
+        )?,
     };
     let n = mesh.positions.len();
     if let Some(bad) = mesh.indices.iter().find(|&&i| i as usize >= n) {
@@ -138,12 +159,48 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<MeshData> {
     Ok(mesh)
 }
 
-/// Parses the header; returns the format, elements and body offset.
-fn parse_header(bytes: &[u8], path: &Path) -> Result<(Format, Vec<Element>, usize)> {
+/// Requires a `vertex` element with `x y z` and a `face` element with a
+/// vertex index list, so a mesh cannot silently come out empty.
+fn check_elements(h: &Header, path: &Path) -> Result<()> {
+    let at = |line: u32, m: String| {
+        let loc = Loc {
+            file: path.into(),
+            line,
+            col: 1,
+        };
+        SceneError::at(&loc, m)
+    };
+    let find = |name: &str| h.elements.iter().find(|e| e.name == name);
+    let Some(v) = find("vertex") else {
+        return Err(at(
+            h.lines,
+            "PLY header declares no 'vertex' element".into(),
+        ));
+    };
+    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+        if !v.props.iter().any(|p| p.slot == Slot::Pos(axis)) {
+            let m = format!("PLY 'vertex' element has no '{name}' property");
+            return Err(at(v.line, m));
+        }
+    }
+    let faces = find("face").filter(|f| f.props.iter().any(|p| p.slot == Slot::VertexIndices));
+    if faces.is_none() {
+        return Err(at(
+            find("face").map_or(h.lines, |f| f.line),
+            "PLY header declares no 'face' element with a 'vertex_indices' list".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Parses the header.
+fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let mut pos = 0;
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
+    let mut lines = 0;
     for line_no in 1u32.. {
+        lines = line_no;
         let err = |m: String| {
             SceneError::at(
                 &Loc {
@@ -177,10 +234,14 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<(Format, Vec<Element>, usiz
                 let count = count
                     .parse()
                     .map_err(|_| err(format!("bad element count '{count}'")))?;
+                if elements.iter().any(|e| e.name == *name) {
+                    return Err(err(format!("PLY element '{name}' declared twice")));
+                }
                 elements.push(Element {
                     name: name.to_string(),
                     count,
                     props: Vec::new(),
+                    line: line_no,
                 });
             }
             ["property", rest @ ..] => {
@@ -196,7 +257,12 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<(Format, Vec<Element>, usiz
     }
     let format = format
         .ok_or_else(|| SceneError::at(&Loc::file_only(path), "PLY header has no 'format' line"))?;
-    Ok((format, elements, pos))
+    Ok(Header {
+        format,
+        elements,
+        body_start: pos,
+        lines,
+    })
 }
 
 /// Parses `property <type> <name>` or `property list <ct> <it> <name>`.
@@ -235,36 +301,46 @@ fn property(words: &[&str], element: &str) -> std::result::Result<Property, Stri
 trait Source {
     /// Reads one value of type `ty`.
     fn value(&mut self, ty: Scalar) -> Result<f64>;
-    /// The file being decoded.
-    fn path(&self) -> &Path;
+    /// An error about the value read last, located in the file.
+    fn error(&self, message: String) -> SceneError;
+    /// An error if anything but (ASCII) whitespace is left.
+    fn finish(&mut self) -> Result<()>;
 }
 
 /// Binary body; `BIG` selects big-endian.
 struct Binary<'a, const BIG: bool> {
     data: &'a [u8],
     pos: usize,
+    /// Start of the last value read.
+    last: usize,
+    /// File offset of `data[0]`.
+    offset: usize,
     path: &'a Path,
 }
 
 impl<'a, const BIG: bool> Binary<'a, BIG> {
-    fn new(data: &'a [u8], path: &'a Path) -> Self {
-        Binary { data, pos: 0, path }
+    fn new(data: &'a [u8], path: &'a Path, offset: usize) -> Self {
+        Binary {
+            data,
+            pos: 0,
+            last: 0,
+            offset,
+            path,
+        }
     }
 
     fn take<const N: usize>(&mut self) -> Result<[u8; N]> {
+        self.last = self.pos;
         let bytes = self
             .data
-            .get(self.pos..self.pos + N)
+            .get(self.pos..self.pos.saturating_add(N))
             .and_then(|s| <[u8; N]>::try_from(s).ok());
         match bytes {
             Some(b) => {
                 self.pos += N;
                 Ok(b)
             }
-            None => Err(SceneError::at(
-                &Loc::file_only(self.path),
-                format!("unexpected end of PLY data at body byte {}", self.pos),
-            )),
+            None => Err(self.error("unexpected end of PLY data".into())),
         }
     }
 }
@@ -281,10 +357,6 @@ macro_rules! decode {
 }
 
 impl<const BIG: bool> Source for Binary<'_, BIG> {
-    fn path(&self) -> &Path {
-        self.path
-    }
-
     fn value(&mut self, ty: Scalar) -> Result<f64> {
         Ok(match ty {
             Scalar::I8 => decode!(self, i8, 1),
@@ -297,78 +369,135 @@ impl<const BIG: bool> Source for Binary<'_, BIG> {
             Scalar::F64 => decode!(self, f64, 8),
         })
     }
+
+    fn error(&self, message: String) -> SceneError {
+        let at = self.offset.saturating_add(self.last);
+        SceneError::at(
+            &Loc::file_only(self.path),
+            format!("{message} (binary data at byte {at})"),
+        )
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        let left = self.data.len().saturating_sub(self.pos);
+        if left == 0 {
+            return Ok(());
+        }
+        self.last = self.pos;
+        Err(self.error(format!("{left} bytes {TRAILING}")))
+    }
 }
+
+/// The message for data after the last element.
+const TRAILING: &str =
+    "of data after the last element the header declares (are the header's counts too small?)";
 
 /// ASCII body: whitespace-separated numbers.
 struct Ascii<'a> {
     data: &'a [u8],
     pos: usize,
+    /// Line and column of the last word read.
+    line: u32,
+    col: u32,
+    /// Current line number and the offset where it starts.
+    cur_line: u32,
+    line_start: usize,
     path: &'a Path,
 }
 
 impl<'a> Ascii<'a> {
-    fn new(data: &'a [u8], path: &'a Path) -> Self {
-        Ascii { data, pos: 0, path }
+    /// A reader of `data`, which starts after header line `header_lines`.
+    fn new(data: &'a [u8], path: &'a Path, header_lines: u32) -> Self {
+        let first = header_lines.saturating_add(1);
+        Ascii {
+            data,
+            pos: 0,
+            line: first,
+            col: 1,
+            cur_line: first,
+            line_start: 0,
+            path,
+        }
     }
-}
 
-impl Source for Ascii<'_> {
-    fn path(&self) -> &Path {
-        self.path
-    }
-
-    fn value(&mut self, _ty: Scalar) -> Result<f64> {
+    /// Skips whitespace, then returns the next word (empty at the end).
+    fn word(&mut self) -> &'a [u8] {
         let d = self.data;
-        while d.get(self.pos).is_some_and(|b| b.is_ascii_whitespace()) {
+        while let Some(&b) = d.get(self.pos).filter(|b| b.is_ascii_whitespace()) {
             self.pos += 1;
+            if b == b'\n' {
+                self.cur_line = self.cur_line.saturating_add(1);
+                self.line_start = self.pos;
+            }
         }
         let start = self.pos;
         while d.get(self.pos).is_some_and(|b| !b.is_ascii_whitespace()) {
             self.pos += 1;
         }
-        let word = d.get(start..self.pos).unwrap_or(&[]);
+        self.line = self.cur_line;
+        self.col = u32::try_from(start - self.line_start + 1).unwrap_or(u32::MAX);
+        d.get(start..self.pos).unwrap_or(&[])
+    }
+}
+
+impl Source for Ascii<'_> {
+    fn value(&mut self, _ty: Scalar) -> Result<f64> {
+        let word = self.word();
+        if word.is_empty() {
+            return Err(self.error("unexpected end of PLY data".into()));
+        }
         match std::str::from_utf8(word)
             .ok()
             .and_then(|s| s.parse::<f64>().ok())
         {
             Some(v) => Ok(v),
-            None => Err(SceneError::at(
-                &Loc::file_only(self.path),
-                format!(
-                    "expected a number in ASCII PLY body at byte {start}, found '{}'",
-                    String::from_utf8_lossy(word)
-                ),
-            )),
+            None => Err(self.error(format!(
+                "expected a number, found '{}'",
+                String::from_utf8_lossy(word)
+            ))),
         }
+    }
+
+    fn error(&self, message: String) -> SceneError {
+        let loc = Loc {
+            file: self.path.into(),
+            line: self.line,
+            col: self.col,
+        };
+        SceneError::at(&loc, message)
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        let word = self.word();
+        if word.is_empty() {
+            return Ok(());
+        }
+        Err(self.error(format!("'{}' {TRAILING}", String::from_utf8_lossy(word))))
     }
 }
 
-/// Reads all elements; `len` bounds preallocation for corrupt counts.
-fn read_body<S: Source>(src: &mut S, elements: &[Element], len: usize) -> Result<MeshData> {
+/// Reads all elements, then requires the body to end there.
+fn read_body<S: Source>(src: &mut S, elements: &[Element]) -> Result<MeshData> {
     let mut mesh = MeshData::default();
     let mut poly = Vec::new();
+    let nverts = elements
+        .iter()
+        .find(|e| e.name == "vertex")
+        .map_or(0, |e| e.count);
     for el in elements {
         let has = |f: fn(&Slot) -> bool| el.props.iter().any(|p| f(&p.slot));
         let want_n = has(|s| matches!(s, Slot::Normal(_)));
         let want_uv = has(|s| matches!(s, Slot::Uv(_)));
         let want_fi = has(|s| *s == Slot::FaceIndex);
-        if el.props.is_empty() && el.count > len {
-            return Err(SceneError::at(
-                &Loc::file_only(src.path()),
-                format!(
-                    "element '{}' claims {} records but has no properties",
-                    el.name, el.count
-                ),
-            ));
+        // Records without properties are empty: skip them without looping
+        // over a count that may be absurd.
+        if el.props.is_empty() {
+            continue;
         }
-        let cap = el.count.min(len);
-        if el.name == "vertex" {
-            mesh.positions.reserve(cap);
-        }
-        for _ in 0..el.count {
+        for record in 0..el.count {
             let mut rec = Record::default();
             for p in &el.props {
-                read_property(src, p, &mut rec, &mut poly)?;
+                read_property(src, p, &mut rec, &mut poly, nverts)?;
             }
             if el.name == "vertex" {
                 mesh.positions.push(rec.pos);
@@ -379,11 +508,18 @@ fn read_body<S: Source>(src: &mut S, elements: &[Element], len: usize) -> Result
                     mesh.uvs.get_or_insert_with(Vec::new).push(rec.uv);
                 }
             } else if el.name == "face" {
+                if poly.len() < 3 {
+                    return Err(src.error(format!(
+                        "face {record} has {} vertex indices (a face needs at least 3)",
+                        poly.len()
+                    )));
+                }
                 triangulate(&poly, &mut mesh, want_fi.then_some(rec.face_index));
                 poly.clear();
             }
         }
     }
+    src.finish()?;
     Ok(mesh)
 }
 
@@ -396,12 +532,14 @@ struct Record {
     face_index: i32,
 }
 
-/// Reads one property into `rec` (or `poly` for vertex indices).
+/// Reads one property into `rec` (or `poly` for vertex indices, which must
+/// be below `nverts`).
 fn read_property<S: Source>(
     src: &mut S,
     p: &Property,
     rec: &mut Record,
     poly: &mut Vec<u32>,
+    nverts: usize,
 ) -> Result<()> {
     let Some(count_ty) = p.list else {
         let v = src.value(p.ty)?;
@@ -416,22 +554,19 @@ fn read_property<S: Source>(
     };
     let count = src.value(count_ty)?;
     if count < 0.0 || count.fract() != 0.0 {
-        return Err(bad_value(src, "list count", count));
+        return Err(src.error(format!("invalid list count {count}")));
     }
     for _ in 0..count as usize {
         let v = src.value(p.ty)?;
         if p.slot == Slot::VertexIndices {
-            if !(0.0..=u32::MAX as f64).contains(&v) {
-                return Err(bad_value(src, "vertex index", v));
+            if !(v >= 0.0 && v.fract() == 0.0 && v < nverts as f64) {
+                let m = format!("vertex index {v} out of range (the mesh has {nverts} vertices)");
+                return Err(src.error(m));
             }
             poly.push(v as u32);
         }
     }
     Ok(())
-}
-
-fn bad_value<S: Source>(src: &S, what: &str, v: f64) -> SceneError {
-    SceneError::at(&Loc::file_only(src.path()), format!("invalid {what} {v}"))
 }
 
 /// Fan-triangulates one polygon into `mesh` (degenerate ones are skipped).

@@ -66,7 +66,8 @@ pub(crate) fn from_string(
 
 /// Reads a `.spd` file: whitespace-separated (λ, value) pairs, `#` comments.
 pub(crate) fn read_spd(path: &Path, loc: &Loc) -> Result<Vec<(f32, f32)>, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::io(loc, path, e))?;
+    let bytes = crate::input::read_file(path, loc, crate::input::MAX_SPECTRUM_FILE_BYTES)?;
+    let text = String::from_utf8_lossy(&bytes);
     let mut values = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let content = line.split('#').next().unwrap_or("");

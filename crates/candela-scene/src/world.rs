@@ -7,7 +7,7 @@
 //! the instance, as in pbrt-v4). Participating media are rejected with an
 //! "unsupported" error at the directive.
 
-use crate::builder::{with_defaults, Block, Builder};
+use crate::builder::{weight, with_defaults, Block, Builder};
 use crate::desc::*;
 use crate::error::{Loc, SceneError};
 use crate::param::ParamSet;
@@ -53,7 +53,7 @@ impl Builder {
         {
             return Err(SceneError::at(loc, format!("redefining texture '{name}'")));
         }
-        let params = with_defaults(&self.gs.attributes.texture, params);
+        let params = with_defaults(&self.gs.attributes.texture, params, &mut self.budget, loc)?;
         let render_from_texture = self.ctm(loc, "texture");
         self.desc.textures.push(TextureDesc {
             name,
@@ -67,13 +67,13 @@ impl Builder {
         Ok(())
     }
 
-    fn material_desc(&self, ty: String, params: ParamSet, loc: &Loc) -> MaterialDesc {
-        MaterialDesc {
+    fn material_desc(&mut self, ty: String, params: ParamSet, loc: &Loc) -> Result<MaterialDesc> {
+        Ok(MaterialDesc {
             ty,
-            params: with_defaults(&self.gs.attributes.material, params),
+            params: with_defaults(&self.gs.attributes.material, params, &mut self.budget, loc)?,
             color_space: self.gs.color_space.clone(),
             loc: loc.clone(),
-        }
+        })
     }
 
     /// `Material "type" params`: an anonymous material becomes current.
@@ -83,7 +83,7 @@ impl Builder {
         if let Some(w) = upgrade::material(&mut ty, &mut params, loc)? {
             self.warn(loc, w);
         }
-        let m = self.material_desc(ty, params, loc);
+        let m = self.material_desc(ty, params, loc)?;
         self.desc.materials.push(m);
         self.gs.material = MaterialRef::Index(self.desc.materials.len() - 1);
         Ok(())
@@ -97,7 +97,7 @@ impl Builder {
         loc: &Loc,
     ) -> Result<()> {
         self.require_world("MakeNamedMaterial", loc)?;
-        let mut m = self.material_desc(String::new(), params, loc);
+        let mut m = self.material_desc(String::new(), params, loc)?;
         m.ty = m.params.get_string("type", "")?;
         if m.ty.is_empty() {
             return Err(SceneError::at(
@@ -133,7 +133,7 @@ impl Builder {
         if let Some(w) = upgrade::light(&name, &mut params, loc)? {
             self.warn(loc, w);
         }
-        let params = with_defaults(&self.gs.attributes.light, params);
+        let params = with_defaults(&self.gs.attributes.light, params, &mut self.budget, loc)?;
         let render_from_light = self.ctm(loc, "light");
         self.desc.lights.push(LightDesc {
             name,
@@ -158,7 +158,7 @@ impl Builder {
         if let Some(w) = upgrade::area_light(&mut name, &mut params, loc)? {
             self.warn(loc, w);
         }
-        let params = with_defaults(&self.gs.attributes.light, params);
+        let params = with_defaults(&self.gs.attributes.light, params, &mut self.budget, loc)?;
         self.gs.area_light = Some(self.entity(name, params, loc));
         Ok(())
     }
@@ -170,8 +170,11 @@ impl Builder {
         if let Some(w) = upgrade::shape(&name, &mut params, loc) {
             self.warn(loc, w);
         }
-        let params = with_defaults(&self.gs.attributes.shape, params);
+        let params = with_defaults(&self.gs.attributes.shape, params, &mut self.budget, loc)?;
         let (render_from_object, render_from_object_end) = self.ctm_motion();
+        if let Some(al) = &self.gs.area_light {
+            self.budget.charge(weight(&al.params.params), loc)?;
+        }
         let mut area_light = self.gs.area_light.clone();
         if self.object.is_some() && area_light.is_some() {
             self.warn(
@@ -210,7 +213,7 @@ impl Builder {
         if !self.object_names.insert(name.clone()) {
             return Err(SceneError::at(loc, format!("redefining object '{name}'")));
         }
-        self.push(Block::Object, loc);
+        self.push(Block::Object, loc)?;
         self.object = Some(InstanceDefinition {
             name,
             shapes: Vec::new(),

@@ -168,11 +168,17 @@ fn gzipped_ply() {
 
 #[test]
 fn invalid_files_are_errors() {
-    let e = parse_ply(&binary_ply(false, true), Path::new("b.ply")).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "b.ply: vertex index 4 out of range (the mesh has 4 vertices)"
-    );
+    let bad = binary_ply(false, true);
+    let e = parse_ply(&bad, Path::new("b.ply")).unwrap_err().to_string();
+    let at: usize = e
+        .strip_prefix(
+            "b.ply: vertex index 4 out of range (the mesh has 4 vertices) (binary data at byte ",
+        )
+        .and_then(|r| r.strip_suffix(')'))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{e}"));
+    // The offset names the bad index itself: the last 4 bytes of the file.
+    assert_eq!(at, bad.len() - 4);
     let mut truncated = binary_ply(true, false);
     truncated.truncate(truncated.len() - 3);
     assert!(parse_ply(&truncated, Path::new("b.ply")).is_err());
@@ -229,4 +235,170 @@ fn million_triangles_binary_is_fast() {
     assert!(m.indices.len() / 3 >= 1_000_000);
     eprintln!("1M-triangle binary PLY decoded in {secs:.3} s");
     assert!(secs < 1.0, "{secs}");
+}
+
+/// A little-endian triangle mesh: `declared` vertices in the header, `held`
+/// in the body, one face with the indices `face`.
+fn small_binary(declared: usize, held: usize, face: &[u32]) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {declared}\nproperty float x\n\
+         property float y\nproperty float z\nelement face 1\n\
+         property list uchar uint vertex_indices\nend_header\n"
+    )
+    .into_bytes();
+    for i in 0..held {
+        for c in [i as f32, 1.0, 0.0] {
+            out.extend(c.to_le_bytes());
+        }
+    }
+    out.push(face.len() as u8);
+    for &v in face {
+        out.extend(v.to_le_bytes());
+    }
+    out
+}
+
+#[test]
+fn header_counts_that_disagree_with_the_body_are_errors() {
+    let p = Path::new("m.ply");
+    assert_eq!(
+        parse_ply(&small_binary(3, 3, &[0, 1, 2]), p)
+            .unwrap()
+            .indices
+            .len(),
+        3
+    );
+    // One vertex more than declared: the face then reads vertex data and
+    // bytes are left over. Before, this could come out as 0 triangles.
+    let e = parse_ply(&small_binary(3, 4, &[0, 1, 2]), p)
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("m.ply: "), "{e}");
+    // Whatever the misread, it is an error naming a byte offset.
+    assert!(e.contains("(binary data at byte "), "{e}");
+    let mut trailing = small_binary(3, 3, &[0, 1, 2]);
+    trailing.extend([0u8; 5]);
+    let e = parse_ply(&trailing, p).unwrap_err().to_string();
+    assert!(e.contains("5 bytes of data after the last element"), "{e}");
+    // Fewer vertices than declared: the face is read as the last vertex,
+    // leaving one byte as an empty face (or nothing at all).
+    let e = parse_ply(&small_binary(4, 3, &[0, 1, 2]), p)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("face 0 has 0 vertex indices"), "{e}");
+    let e = parse_ply(&small_binary(5, 3, &[0, 1, 2]), p)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unexpected end of PLY data"), "{e}");
+}
+
+#[test]
+fn faces_with_fewer_than_three_indices_are_errors() {
+    let p = Path::new("m.ply");
+    for face in [&[0u32, 1][..], &[2][..], &[][..]] {
+        let e = parse_ply(&small_binary(3, 3, face), p)
+            .unwrap_err()
+            .to_string();
+        let want = format!(
+            "face 0 has {} vertex indices (a face needs at least 3)",
+            face.len()
+        );
+        assert!(e.contains(&want), "{e}");
+    }
+    let ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                 property float z\nelement face 2\nproperty list uchar int vertex_indices\n\
+                 end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n  2 0 1\n";
+    let e = parse_ply(ascii.as_bytes(), p).unwrap_err().to_string();
+    // Located at the last index of the short face: line 14, column 7.
+    assert_eq!(
+        e,
+        "m.ply:14:7: face 1 has 2 vertex indices (a face needs at least 3)"
+    );
+}
+
+#[test]
+fn ascii_errors_name_line_and_column() {
+    let p = Path::new("a.ply");
+    let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+                end_header\n";
+    let e = parse_ply(format!("{head}0 0 0\n1 0 x\n").as_bytes(), p).unwrap_err();
+    assert_eq!(e.to_string(), "a.ply:11:5: expected a number, found 'x'");
+    let e = parse_ply(
+        format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n").as_bytes(),
+        p,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "a.ply:13:7: vertex index 3 out of range (the mesh has 3 vertices)"
+    );
+    let e = parse_ply(
+        format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n7\n").as_bytes(),
+        p,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("a.ply:14:1: '7' of data after the last element"),
+        "{e}"
+    );
+    // Trailing whitespace is fine.
+    let ok = format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n  \n");
+    assert_eq!(parse_ply(ok.as_bytes(), p).unwrap().indices, [0, 1, 2]);
+}
+
+#[test]
+fn headers_without_a_mesh_or_with_absurd_counts_are_errors() {
+    let p = Path::new("h.ply");
+    let e = parse_ply(b"ply\nformat ascii 1.0\nend_header\n", p).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "h.ply:3:1: PLY header declares no 'vertex' element"
+    );
+    let e = parse_ply(
+        b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float z\nend_header\n",
+        p,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "h.ply:3:1: PLY 'vertex' element has no 'y' property"
+    );
+    let e = parse_ply(
+        b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n\
+          property float z\nelement face 0\nend_header\n",
+        p,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("h.ply:7:1: PLY header declares no 'face'"),
+        "{e}"
+    );
+    // Counts near usize::MAX neither allocate nor loop: an element without
+    // properties is skipped, and one with properties runs out of data.
+    let huge = format!(
+        "ply\nformat binary_little_endian 1.0\nelement junk {max}\nelement vertex {max}\n\
+         property float x\nproperty float y\nproperty float z\nelement face {max}\n\
+         property list uint uint vertex_indices\nend_header\n\x01\x02",
+        max = usize::MAX
+    );
+    let e = parse_ply(huge.as_bytes(), p).unwrap_err();
+    assert!(e.to_string().contains("unexpected end of PLY data"), "{e}");
+    let dup = b"ply\nformat ascii 1.0\nelement vertex 0\nelement vertex 0\nend_header\n";
+    let e = parse_ply(dup, p).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "h.ply:4:1: PLY element 'vertex' declared twice"
+    );
+}
+
+#[test]
+fn devices_and_directories_are_refused_as_meshes() {
+    let e = read_ply(Path::new("/dev/zero")).unwrap_err();
+    assert!(matches!(e, SceneError::Io { .. }), "{e}");
+    assert!(e.to_string().contains("not a regular file"), "{e}");
+    let e = read_ply(&std::env::temp_dir()).unwrap_err();
+    assert!(e.to_string().contains("is a directory"), "{e}");
 }

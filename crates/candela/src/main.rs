@@ -6,9 +6,9 @@ mod output;
 mod progress;
 mod render_cmd;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use candela_core::build::{build, summarize, Overrides};
-use candela_core::image::{compare, RgbImage};
+use candela_core::image::{compare, non_finite, RgbImage};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -105,6 +105,23 @@ fn diff(a: &Path, b: &Path, region: Option<[usize; 4]>) -> Result<()> {
         ib = ib
             .crop(r)
             .with_context(|| format!("region outside {}", b.display()))?;
+    }
+    // Positions are reported in the full image, not in the region.
+    let (x0, y0) = region.map_or((0, 0), |r| (r[0], r[1]));
+    let mut bad = Vec::new();
+    for (img, path) in [(&ia, a), (&ib, b)] {
+        if let Some(nf) = non_finite(img) {
+            bad.push(format!(
+                "{}: {} non-finite (NaN or infinite) pixels, the first at ({}, {})",
+                path.display(),
+                nf.count,
+                x0 + nf.first.0,
+                y0 + nf.first.1
+            ));
+        }
+    }
+    if !bad.is_empty() {
+        bail!("{}", bad.join("; "));
     }
     let c = compare(&ia, &ib)?;
     let (ma, mb) = (ia.channel_means(), ib.channel_means());

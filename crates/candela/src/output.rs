@@ -58,7 +58,10 @@ pub fn attributes(dev: &Developed, integrator: &str, total_passes: u64) -> ExrAt
     let int = |v: u64| ExrAttribute::Int(i32::try_from(v).unwrap_or(i32::MAX));
     a.insert("candela.passes".into(), int(dev.passes));
     a.insert("candela.plannedPasses".into(), int(total_passes));
-    a.insert("candela.integrator".into(), ExrAttribute::Text(integrator.to_string()));
+    a.insert(
+        "candela.integrator".into(),
+        ExrAttribute::Text(integrator.to_string()),
+    );
     a
 }
 

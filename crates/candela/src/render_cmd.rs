@@ -102,6 +102,11 @@ pub struct RenderArgs {
     /// Render whole passes until this many seconds are spent.
     #[arg(long, value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
+    /// Render only the part x0 ≤ x < x1, y0 ≤ y < y1 of the image, in [0, 1]
+    /// fractions of the film ("x0,x1,y0,y1", pbrt-v4's `--cropwindow`);
+    /// overrides the Film's "cropwindow" and "pixelbounds".
+    #[arg(long, value_parser = parse_cropwindow)]
+    pub cropwindow: Option<[f32; 4]>,
     /// Stop once the relative standard error of the image mean (every
     /// channel, from the spread of the per-pass means) is below this.
     #[arg(long, value_parser = parse_error)]
@@ -116,7 +121,21 @@ impl RenderArgs {
             integrator: self.integrator.clone(),
             outfile: self.outfile.clone(),
             seed: self.seed,
+            cropwindow: self.cropwindow,
         }
+    }
+}
+
+/// Parses "x0,x1,y0,y1" with 0 ≤ x0 < x1 ≤ 1 and 0 ≤ y0 < y1 ≤ 1.
+fn parse_cropwindow(s: &str) -> Result<[f32; 4], String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f32>().map_err(|e| format!("{t:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    let unit = |a: f32, b: f32| (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b) && a < b;
+    match v[..] {
+        [x0, x1, y0, y1] if unit(x0, x1) && unit(y0, y1) => Ok([x0, x1, y0, y1]),
+        _ => Err("expected x0,x1,y0,y1 in [0, 1] with x0 < x1 and y0 < y1".into()),
     }
 }
 
@@ -132,6 +151,9 @@ fn settings_text(ov: &Overrides) -> String {
     if let Some(v) = ov.seed {
         s.push_str(&format!("seed={v}\n"));
     }
+    if let Some([a, b, c, d]) = ov.cropwindow {
+        s.push_str(&format!("cropwindow={a:?},{b:?},{c:?},{d:?}\n"));
+    }
     s
 }
 
@@ -146,6 +168,9 @@ fn overrides_from(text: &str) -> Result<Overrides> {
             "spp" => ov.spp = Some(v.parse().context("spp in the state file")?),
             "integrator" => ov.integrator = Some(v.to_string()),
             "seed" => ov.seed = Some(v.parse().context("seed in the state file")?),
+            "cropwindow" => {
+                ov.cropwindow = Some(parse_cropwindow(v).map_err(anyhow::Error::msg)?);
+            }
             _ => bail!("unknown setting {k:?} in the state file"),
         }
     }

@@ -56,7 +56,13 @@ pub fn film(
         .outfile
         .clone()
         .unwrap_or_else(|| PathBuf::from(filename));
-    let pixel_bounds = pixel_bounds(p, res, &e.loc)?;
+    let pixel_bounds = match ov.cropwindow {
+        Some(cw) => {
+            let _ = (p.get_ints("pixelbounds")?, p.get_floats("cropwindow")?);
+            crop_bounds(cw, res)
+        }
+        None => pixel_bounds(p, res, &e.loc)?,
+    };
     let max_component_value = p.get_float("maxcomponentvalue", f32::INFINITY)?;
     let _ = p.get_bool("savefp16", true)?; // candela always writes 32-bit float EXR.
     let iso = p.get_float("iso", 100.0)?;
@@ -148,14 +154,20 @@ fn pixel_bounds(
                 "\"cropwindow\" must be 4 floats x0 x1 y0 y1 with x0 < x1, y0 < y1",
             ));
         }
-        let c = |v: f32, r: u32| ((v.clamp(0.0, 1.0) * r as f32).ceil() as u32).min(r);
-        let lo = UVec2::new(c(cw[0], res.x), c(cw[2], res.y));
-        let hi = UVec2::new(c(cw[1], res.x), c(cw[3], res.y))
-            .max(lo + UVec2::ONE)
-            .min(res);
-        return Ok((lo, hi));
+        return Ok(crop_bounds([cw[0], cw[1], cw[2], cw[3]], res));
     }
     Ok((UVec2::ZERO, res))
+}
+
+/// Pixel bounds of crop window `[x0, x1, y0, y1]` (fractions of the film,
+/// pbrt-v4's rounding up), at least one pixel wide and tall.
+fn crop_bounds(cw: [f32; 4], res: UVec2) -> (UVec2, UVec2) {
+    let c = |v: f32, r: u32| ((v.clamp(0.0, 1.0) * r as f32).ceil() as u32).min(r);
+    let lo = UVec2::new(c(cw[0], res.x), c(cw[2], res.y)).min(res - UVec2::ONE);
+    let hi = UVec2::new(c(cw[1], res.x), c(cw[3], res.y))
+        .max(lo + UVec2::ONE)
+        .min(res);
+    (lo, hi)
 }
 
 /// The pixel filter (pbrt-v4's default is a Gaussian of radius 1.5, σ 0.5).

@@ -79,6 +79,9 @@ pub struct Overrides {
     pub outfile: Option<PathBuf>,
     /// `--seed`.
     pub seed: Option<u64>,
+    /// `--cropwindow x0,x1,y0,y1` (pbrt-v4's; replaces the film's
+    /// `cropwindow` and `pixelbounds`).
+    pub cropwindow: Option<[f32; 4]>,
 }
 
 /// Everything needed to render.

@@ -17,6 +17,28 @@ pub struct Comparison {
     pub worst_block: (f64, usize, usize),
 }
 
+/// The NaN or infinite pixels of an image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NonFinite {
+    /// How many pixels have at least one non-finite channel.
+    pub count: usize,
+    /// The first such pixel in row order, as (x, y).
+    pub first: (usize, usize),
+}
+
+/// The pixels of `img` with a NaN or infinite channel, or `None` if there
+/// are none. Metrics over such pixels are NaN, so `candela diff` reports
+/// these instead.
+pub fn non_finite(img: &RgbImage) -> Option<NonFinite> {
+    let bad = |p: &[f32; 3]| p.iter().any(|c| !c.is_finite());
+    let first = img.pixels.iter().position(bad)?;
+    let width = img.width.max(1);
+    Some(NonFinite {
+        count: img.pixels.iter().filter(|p| bad(p)).count(),
+        first: (first % width, first / width),
+    })
+}
+
 /// Side of the blocks in [`Comparison::worst_block`].
 pub const BLOCK: usize = 32;
 
@@ -107,5 +129,22 @@ mod tests {
         let same = compare(&b, &b).unwrap();
         assert_eq!((same.rel_mse, same.mae), (0.0, 0.0));
         assert!(compare(&a, &RgbImage::new(3, 3)).is_err());
+    }
+
+    #[test]
+    fn non_finite_pixels_are_counted_with_the_first_position() {
+        let mut img = RgbImage::new(5, 4);
+        assert_eq!(non_finite(&img), None);
+        img.pixels[2 * 5 + 3][1] = f32::NAN;
+        img.pixels[3 * 5][2] = f32::INFINITY;
+        img.pixels[3 * 5 + 1] = [f32::NEG_INFINITY, f32::NAN, 0.0];
+        let nf = non_finite(&img).unwrap();
+        assert_eq!(
+            nf,
+            NonFinite {
+                count: 3,
+                first: (3, 2)
+            }
+        );
     }
 }

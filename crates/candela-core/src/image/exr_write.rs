@@ -165,9 +165,9 @@ pub fn write_exr_layers(
     attributes: &ExrAttributes,
 ) -> Result<(), ImageError> {
     let bytes = encode(path, width, height, layers, attributes)?;
-    write_atomic_bytes(path, &bytes).map_err(|source| ImageError::Io {
+    write_atomic_bytes(path, &bytes).map_err(|error| ImageError::Io {
         path: path.display().to_string(),
-        source,
+        error,
     })
 }
 
@@ -243,9 +243,9 @@ fn encode(
         .write()
         .non_parallel()
         .to_buffered(Cursor::new(&mut bytes))
-        .map_err(|source| ImageError::Exr {
+        .map_err(|error| ImageError::Exr {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
     sort_header_attributes(&mut bytes).map_err(|m| format_err(m.to_string()))?;
     Ok(bytes)
@@ -410,9 +410,9 @@ pub fn read_exr_layers(path: &Path) -> Result<ExrImage, ImageError> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|source| ImageError::Exr {
+        .map_err(|error| ImageError::Exr {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
     let layer = img.layer_data;
     let mut grouped: BTreeMap<String, Vec<ExrChannel>> = BTreeMap::new();

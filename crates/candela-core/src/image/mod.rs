@@ -11,7 +11,7 @@ mod read;
 mod resize;
 
 pub use atomic::{write_atomic, write_atomic_bytes};
-pub use compare::{compare, Comparison};
+pub use compare::{compare, non_finite, Comparison, NonFinite};
 pub use exr_write::{
     encode_exr_layers, read_exr_layers, write_exr_layers, ExrAttribute, ExrAttributes, ExrChannel,
     ExrImage, ExrLayer,
@@ -25,31 +25,36 @@ use std::path::Path;
 use thiserror::Error;
 
 /// Failure reading or writing an image file.
+///
+/// The codec's error is printed in the message and deliberately not chained
+/// as a `source()`: the codecs' errors chain their I/O error in turn, so an
+/// error reporter walking the chain (`anyhow`'s `{:#}`) would print the same
+/// "No such file or directory" three times.
 #[derive(Debug, Error)]
 pub enum ImageError {
     /// The EXR codec failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Exr {
         /// File.
         path: String,
         /// Cause.
-        source: exr::error::Error,
+        error: exr::error::Error,
     },
     /// The PNG codec failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Png {
         /// File.
         path: String,
         /// Cause.
-        source: image::ImageError,
+        error: image::ImageError,
     },
     /// Writing the file failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// File.
         path: String,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (not a `source`: the message already holds it).
+        error: std::io::Error,
     },
     /// The file is not a map candela can read.
     #[error("{path}: {msg}")]
@@ -102,9 +107,9 @@ impl RgbImage {
                 img.pixels[pos.y() * w + pos.x()] = [r, g, b];
             },
         )
-        .map_err(|source| ImageError::Exr {
+        .map_err(|error| ImageError::Exr {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         Ok(img.layer_data.channel_data.pixels)
     }
@@ -142,13 +147,13 @@ impl RgbImage {
                 self.height as u32,
                 image::ExtendedColorType::Rgb8,
             )
-            .map_err(|source| ImageError::Png {
+            .map_err(|error| ImageError::Png {
                 path: name(),
-                source,
+                error,
             })?;
-        write_atomic_bytes(path, &png).map_err(|source| ImageError::Io {
+        write_atomic_bytes(path, &png).map_err(|error| ImageError::Io {
             path: name(),
-            source,
+            error,
         })
     }
 

@@ -115,9 +115,9 @@ fn format_error(path: &Path, msg: impl Into<String>) -> ImageError {
 
 fn read_png(path: &Path, enc: ColorEncoding) -> Result<MapImage, ImageError> {
     use image::DynamicImage as D;
-    let png_err = |source| ImageError::Png {
+    let png_err = |error| ImageError::Png {
         path: path.display().to_string(),
-        source,
+        error,
     };
     let img = image::ImageReader::open(path)
         .map_err(|e| png_err(image::ImageError::IoError(e)))?
@@ -169,9 +169,9 @@ fn texels<T: Copy>(
 
 fn read_exr_map(path: &Path) -> Result<MapFile, ImageError> {
     use exr::prelude::{read_first_flat_layer_from_file, FlatSamples};
-    let img = read_first_flat_layer_from_file(path).map_err(|source| ImageError::Exr {
+    let img = read_first_flat_layer_from_file(path).map_err(|error| ImageError::Exr {
         path: path.display().to_string(),
-        source,
+        error,
     })?;
     let layer = &img.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());

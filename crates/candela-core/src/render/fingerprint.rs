@@ -52,8 +52,8 @@ pub fn fingerprint(desc: &SceneDescription, ov: &Overrides, layout: &FilmLayout)
         }
     });
     let settings = format!(
-        "spp={:?} integrator={:?} seed={:?} layout={:?}",
-        ov.spp, ov.integrator, ov.seed, layout
+        "spp={:?} integrator={:?} seed={:?} cropwindow={:?} layout={:?}",
+        ov.spp, ov.integrator, ov.seed, ov.cropwindow, layout
     );
     h.push(murmur_hash64a(settings.as_bytes(), 0));
     hash_u64s(&h)

@@ -22,12 +22,12 @@ const MAGIC: &[u8; 8] = b"CNDLST01";
 #[derive(Debug, Error)]
 pub enum StateError {
     /// The file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// File.
         path: String,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (not a `source`: the message already holds it).
+        error: std::io::Error,
     },
     /// Not a candela state file, or damaged.
     #[error("{path}: {what}")]
@@ -168,17 +168,17 @@ impl RenderState {
 
     /// Writes the state to `path` atomically (temporary file, then rename).
     pub fn save(&self, path: &Path) -> Result<(), StateError> {
-        crate::image::write_atomic_bytes(path, &self.to_bytes()).map_err(|source| StateError::Io {
+        crate::image::write_atomic_bytes(path, &self.to_bytes()).map_err(|error| StateError::Io {
             path: path.display().to_string(),
-            source,
+            error,
         })
     }
 
     /// Reads the state file at `path`.
     pub fn load(path: &Path) -> Result<Self, StateError> {
-        let bytes = std::fs::read(path).map_err(|source| StateError::Io {
+        let bytes = std::fs::read(path).map_err(|error| StateError::Io {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         Self::from_bytes(&bytes, path)
     }
