@@ -14,10 +14,12 @@
 //! - `builder`, `world`: pbrt-v4 directive semantics and graphics state.
 //! - `upgrade`: pbrt-v3 syntax rewritten as pbrt-v4's `--upgrade` does.
 //! - `desc`: the output types; `math`: [`Mat4d`]; `ply`: PLY mesh reader.
+//! - `ies`: IES LM-63 photometric files ([`read_ies`]).
 
 mod builder;
 mod desc;
 mod error;
+pub mod ies;
 mod lexer;
 mod math;
 mod param;
@@ -35,6 +37,7 @@ pub use desc::{
     SceneDescription, ShapeDesc, TextureDesc, TextureKind,
 };
 pub use error::{Loc, SceneError, Warning};
+pub use ies::{read_ies, IesFile};
 pub use math::Mat4d;
 pub use param::{Param, ParamSet, ParamType, ParamValue};
 pub use parser::MAX_INCLUDE_DEPTH;
