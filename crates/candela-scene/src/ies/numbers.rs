@@ -71,6 +71,7 @@ impl<'a, F: Fn(u32, u32) -> Loc> Tokens<'a, F> {
         }
     }
 
+    /// The next token, not consumed.
     pub(super) fn peek(&self) -> Option<Tok<'a>> {
         self.toks.get(self.next).copied()
     }

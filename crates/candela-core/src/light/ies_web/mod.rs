@@ -304,6 +304,7 @@ fn polar_weights(t0: f64, t1: f64) -> [f64; 2] {
     [(t0.cos() - t1.cos()) - w1, w1]
 }
 
+/// `a + t·(b − a)`.
 fn lerp(t: f64, a: f64, b: f64) -> f64 {
     a + t * (b - a)
 }

@@ -223,7 +223,7 @@ fn sample_pdf_and_intensity_agree() {
 }
 
 /// χ² of the sampler against its pdf: 10⁶ samples each, α = 0.01 over the
-/// [`CHI2_WEBS`] webs (Šidák). The harness grid is (cos θ, φ) about the light's
+/// six webs (Šidák). The harness grid is (cos θ, φ) about the light's
 /// z; every support boundary here (z = 0, z = 0.5) is a cell boundary.
 #[test]
 fn sampling_passes_chi2() {
