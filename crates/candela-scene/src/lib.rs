@@ -15,10 +15,12 @@
 //! - `builder`, `world`: pbrt-v4 directive semantics and graphics state.
 //! - `upgrade`: pbrt-v3 syntax rewritten as pbrt-v4's `--upgrade` does.
 //! - `desc`: the output types; `math`: [`Mat4d`]; `ply`: PLY mesh reader.
+//! - `ies`: IES LM-63 photometric files ([`read_ies`]).
 
 mod builder;
 mod desc;
 mod error;
+pub mod ies;
 mod input;
 mod lexer;
 mod math;
@@ -38,6 +40,7 @@ pub use desc::{
     MaterialRef, SceneDescription, ShapeDesc, SourceFile, TextureDesc, TextureKind,
 };
 pub use error::{Loc, SceneError, Warning};
+pub use ies::{read_ies, IesFile};
 pub use input::{MAX_PLY_FILE_BYTES, MAX_SCENE_FILE_BYTES, MAX_SPECTRUM_FILE_BYTES};
 pub use math::Mat4d;
 pub use param::{Param, ParamSet, ParamType, ParamValue};
