@@ -224,10 +224,10 @@ pub fn render(
         status: shared.status.lock().map(|s| s.clone()).unwrap_or(None),
     };
     let result = std::thread::scope(|s| {
-        s.spawn(|| {
+        let ticker = s.spawn(|| {
             while !shared.finished.load(Ordering::Relaxed) {
                 progress.update(&snap());
-                std::thread::sleep(Duration::from_millis(250));
+                std::thread::park_timeout(Duration::from_millis(250));
             }
         });
         let r = run_passes(setup, state, opts, &ctx, &todo, &shared, t0, &mut |st| {
@@ -235,6 +235,7 @@ pub fn render(
             on_pass(st);
         });
         shared.finished.store(true, Ordering::Relaxed);
+        ticker.thread().unpark();
         r
     });
     let (reason, passes_rendered) = result?;
