@@ -1,16 +1,20 @@
-//! The 4-wide BVH: node layout, collapse of the binary tree, and traversal.
+//! The wide BVH: node layout, collapse of the binary tree, and traversal.
 
-use super::build::{build_tree, BuildNode, BuildTree, MAX_LEAF, PACK, SAH_DEPTH};
+use super::build::{build_tree, BuildNode, BuildTree, MAX_LEAF, PACK};
 use super::triangle4::{Tri4Ray, TriPack, EMPTY_LANE, OTHER_TAG};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use crate::shape::{TriangleIntersection, WatertightRay};
-use wide::{f32x4, CmpLe};
+use wide::{f32x8, CmpLe};
+
+/// One SIMD vector per node axis and bound: a lane per child.
+type Lanes = f32x8;
 
 /// Children per node.
-const WIDTH: usize = 4;
-/// Traversal stack entries: each node pushes at most `WIDTH - 1`, and the
-/// tree is at most `SAH_DEPTH + 32` levels deep (see [`super::build`]).
-const STACK: usize = (WIDTH - 1) * (SAH_DEPTH + 34);
+const WIDTH: usize = 8;
+/// Traversal stack entries on the call stack; deeper trees (only from
+/// adversarial input: see [`super::build`]) use a heap stack of
+/// [`Bvh::stack_need`] entries.
+const STACK: usize = 64;
 /// Child code of an unused slot.
 const EMPTY_CHILD: u32 = u32::MAX;
 /// Tag of a leaf's child code; bits 28–30 hold the pack count − 1 and bits
@@ -21,18 +25,18 @@ const MAX_PACKS: usize = 1 << 28;
 
 const _: () = assert!(MAX_LEAF.div_ceil(PACK) <= 8);
 
-/// Four children's boxes, as `b[0]` = lower and `b[1]` = upper corners with
-/// one 4-lane vector per axis, and their child codes (128 bytes).
+/// The children's boxes, as `b[0]` = lower and `b[1]` = upper corners with
+/// one vector per axis (a lane per child), and their child codes.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {
-    b: [[f32x4; 3]; 2],
+    b: [[Lanes; 3]; 2],
     child: [u32; WIDTH],
 }
 
-const _: () = assert!(std::mem::size_of::<Node>() == 128);
+const _: () = assert!(std::mem::size_of::<Node>() == 64 * (7 * WIDTH).div_ceil(16));
 
-/// A 4-wide bounding volume hierarchy over items given by their bounds.
+/// An 8-wide bounding volume hierarchy over items given by their bounds.
 /// Items that are triangles are stored in SIMD packs and tested by the
 /// hierarchy itself; other items are tested through a caller closure.
 #[derive(Clone, Debug, Default)]
@@ -43,6 +47,9 @@ pub struct Bvh {
     items: usize,
     has_other: bool,
     depth: usize,
+    /// Stack entries a traversal needs at most: the largest sum of
+    /// (children − 1) along a root-to-leaf path, plus one.
+    stack_need: usize,
 }
 
 /// The closest hit found by [`Bvh::intersect`].
@@ -111,14 +118,17 @@ impl Bvh {
         };
         match &tree.root {
             BuildNode::Interior { .. } => {
-                out.node(&tree.root);
+                out.node(&tree.root, 1);
             }
             leaf => {
                 let code = out.leaf(leaf);
                 let b = leaf.bounds();
                 out.bvh.nodes.push(node_of(&[(b, code)]));
+                out.bvh.stack_need = 1;
             }
         }
+        bvh.nodes.shrink_to_fit();
+        bvh.packs.shrink_to_fit();
         bvh.has_other = bvh.packs.iter().any(|p| {
             p.ids
                 .iter()
@@ -194,7 +204,13 @@ impl Bvh {
         }
         let boxes = RayBoxes::new(ray);
         let tri = Tri4Ray::new(&WatertightRay::new(ray));
-        let mut stack = [(0u32, 0.0f32); STACK];
+        let (mut small, mut big) = ([(0u32, 0.0f32); STACK], Vec::new());
+        let stack: &mut [(u32, f32)] = if self.stack_need <= STACK {
+            &mut small
+        } else {
+            big.resize(self.stack_need, (0, 0.0));
+            &mut big
+        };
         let (mut sp, mut t_max, mut best) = (0usize, t_max, None);
         let mut current = 0u32;
         loop {
@@ -202,7 +218,7 @@ impl Bvh {
                 let node = &self.nodes[current as usize];
                 let (mut mask, t_near) = boxes.hits(node, t_max);
                 let t_near = t_near.to_array();
-                // Hit children, nearest first (insertion sort of at most four).
+                // Hit children, nearest first (insertion sort).
                 let mut order = [(0u32, 0.0f32); WIDTH];
                 let mut k = 0;
                 while mask != 0 {
@@ -272,7 +288,13 @@ impl Bvh {
         }
         let boxes = RayBoxes::new(ray);
         let tri = Tri4Ray::new(&WatertightRay::new(ray));
-        let mut stack = [0u32; STACK];
+        let (mut small, mut big) = ([0u32; STACK], Vec::new());
+        let stack: &mut [u32] = if self.stack_need <= STACK {
+            &mut small
+        } else {
+            big.resize(self.stack_need, 0);
+            &mut big
+        };
         let mut sp = 0usize;
         let mut current = 0u32;
         loop {
@@ -283,7 +305,7 @@ impl Bvh {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     if node.child[i] != EMPTY_CHILD {
-                        stack[sp] = node.child[i];
+                            stack[sp] = node.child[i];
                         sp += 1;
                     }
                 }
@@ -317,8 +339,8 @@ fn other_items(pack: &TriPack) -> impl Iterator<Item = u32> + '_ {
 
 /// A ray's constants for the slab test, splatted over the lanes.
 struct RayBoxes {
-    o: [f32x4; 3],
-    inv_dir: [f32x4; 3],
+    o: [Lanes; 3],
+    inv_dir: [Lanes; 3],
     /// Per axis: true when the direction is negative (the near plane is the upper one).
     neg: [bool; 3],
 }
@@ -329,13 +351,13 @@ impl RayBoxes {
     fn new(ray: &Ray) -> Self {
         let inv = ray.d.recip();
         RayBoxes {
-            o: [ray.o.x, ray.o.y, ray.o.z].map(f32x4::splat),
-            inv_dir: [inv.x, inv.y, inv.z].map(f32x4::splat),
+            o: [ray.o.x, ray.o.y, ray.o.z].map(Lanes::splat),
+            inv_dir: [inv.x, inv.y, inv.z].map(Lanes::splat),
             neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
         }
     }
 
-    /// Slab test of a node's four boxes against `(0, t_max)`: the mask of
+    /// Slab test of a node's boxes against `(0, t_max)`: the mask of
     /// hit children and their entry distances. The far distances are widened
     /// by 1 + 2γ₃ so rounding never culls a box the ray touches [pbrt-v4
     /// §6.8.2]; `maxps`/`minps` return their second operand when the first
@@ -343,9 +365,9 @@ impl RayBoxes {
     /// inside that slab [Ize 2013, "Robust BVH ray traversal"]. Empty slots
     /// have inverted boxes and never hit.
     #[inline(always)]
-    fn hits(&self, n: &Node, t_max: f32) -> (u32, f32x4) {
-        let widen = f32x4::splat(1.0 + 2.0 * gamma(3));
-        let (mut t0, mut t1) = (f32x4::ZERO, f32x4::splat(t_max));
+    fn hits(&self, n: &Node, t_max: f32) -> (u32, Lanes) {
+        let widen = Lanes::splat(1.0 + 2.0 * gamma(3));
+        let (mut t0, mut t1) = (Lanes::ZERO, Lanes::splat(t_max));
         for axis in 0..3 {
             let neg = self.neg[axis] as usize;
             let near = (n.b[neg][axis] - self.o[axis]) * self.inv_dir[axis];
@@ -357,9 +379,9 @@ impl RayBoxes {
     }
 }
 
-/// A node over up to four `(bounds, child code)` pairs.
+/// A node over up to `WIDTH` `(bounds, child code)` pairs.
 fn node_of(children: &[(Bounds3, u32)]) -> Node {
-    let mut b = [[[f32::INFINITY; 4]; 3], [[f32::NEG_INFINITY; 4]; 3]];
+    let mut b = [[[f32::INFINITY; WIDTH]; 3], [[f32::NEG_INFINITY; WIDTH]; 3]];
     let mut child = [EMPTY_CHILD; WIDTH];
     for (i, (bounds, code)) in children.iter().enumerate() {
         for axis in 0..3 {
@@ -369,7 +391,7 @@ fn node_of(children: &[(Bounds3, u32)]) -> Node {
         child[i] = *code;
     }
     Node {
-        b: b.map(|c| c.map(f32x4::from)),
+        b: b.map(|c| c.map(Lanes::new)),
         child,
     }
 }
@@ -383,9 +405,10 @@ struct Collapse<'a, T> {
 
 impl<T: Fn(u32) -> Option<[Vec3; 3]>> Collapse<'_, T> {
     /// Emits the wide node for an interior node: its children are grown to
-    /// four by repeatedly opening the interior child of largest surface area
-    /// (Wald et al. 2008, "Getting rid of packets"). Returns its index.
-    fn node(&mut self, node: &BuildNode) -> u32 {
+    /// `WIDTH` by repeatedly opening the interior child of largest surface
+    /// area (Wald et al. 2008, "Getting rid of packets"). `need` is the
+    /// stack a traversal may hold on reaching it. Returns its index.
+    fn node(&mut self, node: &BuildNode, need: usize) -> u32 {
         let mut kids: Vec<&BuildNode> = match node {
             BuildNode::Interior { children, .. } => children.iter().collect(),
             leaf => vec![leaf],
@@ -408,11 +431,13 @@ impl<T: Fn(u32) -> Option<[Vec3; 3]>> Collapse<'_, T> {
         }
         let index = self.bvh.nodes.len();
         self.bvh.nodes.push(node_of(&[]));
+        let need = need + kids.len() - 1;
+        self.bvh.stack_need = self.bvh.stack_need.max(need);
         let children: Vec<(Bounds3, u32)> = kids
             .iter()
             .map(|k| {
                 let code = match k {
-                    BuildNode::Interior { .. } => self.node(k),
+                    BuildNode::Interior { .. } => self.node(k, need),
                     leaf => self.leaf(leaf),
                 };
                 (k.bounds(), code)

@@ -4,6 +4,8 @@
 pub mod build;
 mod motion;
 mod primitive;
+#[cfg(test)]
+mod tests;
 
 pub use motion::MovingGroup;
 pub use primitive::Primitive;
@@ -102,6 +104,11 @@ impl Scene {
     /// The camera footprint, if set.
     pub fn footprint(&self) -> Option<&PixelFootprint> {
         self.footprint.as_ref()
+    }
+
+    /// Bytes held by the top-level BVH's nodes and triangle packs.
+    pub fn bvh_memory_bytes(&self) -> usize {
+        self.bvh.memory_bytes()
     }
 
     /// Bounds of all geometry.
