@@ -44,7 +44,10 @@ fn main() -> std::io::Result<()> {
     }
     if arg == "--profile" {
         // An optional ray count, for runs under valgrind.
-        let n = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(RAYS);
+        let n = std::env::args()
+            .nth(2)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(RAYS);
         let rays = &rays[..n.min(RAYS)];
         let t0 = Instant::now();
         let hits = trace_closest(&bvh, rays);

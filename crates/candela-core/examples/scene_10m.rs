@@ -54,7 +54,10 @@ fn main() {
         .count();
     let trace = t0.elapsed().as_secs_f64();
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-    println!("{n_tris} triangles: mesh and primitives {mesh_time:.1} s, peak {:.2} GiB before the scene", gib(before));
+    println!(
+        "{n_tris} triangles: mesh and primitives {mesh_time:.1} s, peak {:.2} GiB before the scene",
+        gib(before)
+    );
     println!(
         "Scene::new (BVH build) {build:.1} s on {} threads; BVH {:.1} bytes/triangle; primitive {} bytes",
         rayon::current_num_threads(),

@@ -305,7 +305,7 @@ impl Bvh {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     if node.child[i] != EMPTY_CHILD {
-                            stack[sp] = node.child[i];
+                        stack[sp] = node.child[i];
                         sp += 1;
                     }
                 }

@@ -68,12 +68,26 @@ fn scene_intersection_matches_brute_force() {
     // A moving copy, shifted by +2 in x, still at time 0 (start) and moving later.
     let start = Transform::translate(Vec3::new(2.0, 0.0, 0.0));
     let end = Transform::translate(Vec3::new(2.0, 0.5, 0.0));
-    let mover = MovingGroup::new(mixed_primitives(4), AnimatedTransform::new(start, 0.0, end, 1.0));
-    let scene = Scene::with_motion(prims.clone(), vec![mover], (0.0, 1.0), vec![], vec![], false);
+    let mover = MovingGroup::new(
+        mixed_primitives(4),
+        AnimatedTransform::new(start, 0.0, end, 1.0),
+    );
+    let scene = Scene::with_motion(
+        prims.clone(),
+        vec![mover],
+        (0.0, 1.0),
+        vec![],
+        vec![],
+        false,
+    );
     let mut r = Pcg32::new(9, 9);
     let mut hits = 0;
     for k in 0..3000 {
-        let o = Vec3::new(3.4 * r.uniform_f32() - 0.2, 1.4 * r.uniform_f32() - 0.2, 1.4 * r.uniform_f32() - 0.2);
+        let o = Vec3::new(
+            3.4 * r.uniform_f32() - 0.2,
+            1.4 * r.uniform_f32() - 0.2,
+            1.4 * r.uniform_f32() - 0.2,
+        );
         let d = sample_uniform_sphere(Vec2::new(r.uniform_f32(), r.uniform_f32()));
         let ray = Ray::new(o, d);
         let t_max = if k % 3 == 0 { 0.7 } else { f32::INFINITY };
@@ -83,9 +97,13 @@ fn scene_intersection_matches_brute_force() {
             .into_iter()
             .flatten()
             .fold(None, |b: Option<f32>, t| Some(b.map_or(t, |b| b.min(t))));
-        let got = scene.intersect(&ray, t_max).map(|si| (si.p() - o).length() / d.length());
+        let got = scene
+            .intersect(&ray, t_max)
+            .map(|si| (si.p() - o).length() / d.length());
         match (got, want) {
-            (Some(g), Some(w)) => assert!((g - w).abs() <= 1e-4 * w.max(1.0), "ray {k}: {g} vs {w}"),
+            (Some(g), Some(w)) => {
+                assert!((g - w).abs() <= 1e-4 * w.max(1.0), "ray {k}: {g} vs {w}")
+            }
             (g, w) => assert_eq!(g.is_some(), w.is_some(), "ray {k}: {g:?} vs {w:?}"),
         }
         assert_eq!(scene.intersect_p(&ray, t_max), want.is_some(), "ray {k}");
