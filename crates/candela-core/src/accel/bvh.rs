@@ -384,9 +384,10 @@ fn node_of(children: &[(Bounds3, u32)]) -> Node {
     let mut b = [[[f32::INFINITY; WIDTH]; 3], [[f32::NEG_INFINITY; WIDTH]; 3]];
     let mut child = [EMPTY_CHILD; WIDTH];
     for (i, (bounds, code)) in children.iter().enumerate() {
-        for axis in 0..3 {
-            b[0][axis][i] = bounds.min[axis];
-            b[1][axis][i] = bounds.max[axis];
+        let [lo, hi] = &mut b;
+        for (axis, (lo, hi)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
+            lo[i] = bounds.min[axis];
+            hi[i] = bounds.max[axis];
         }
         child[i] = *code;
     }

@@ -176,9 +176,9 @@ impl Tri4Ray {
         let mut t_best = t_max;
         if lanes.hit != 0 {
             let t = lanes.t.to_array();
-            for lane in 0..4 {
-                if lanes.hit & (1 << lane) != 0 && t[lane] < t_best {
-                    t_best = t[lane];
+            for (lane, &t) in t.iter().enumerate() {
+                if lanes.hit & (1 << lane) != 0 && t < t_best {
+                    t_best = t;
                     best = Some(lane);
                 }
             }
