@@ -230,40 +230,8 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     }
     let exr = output::exr_path(&setup.outfile)?;
     output::check_writable(&exr)?;
-    let total = setup.sampler.samples_per_pixel() as u64;
-    let passes = args.pass_range.unwrap_or((0, total));
-    if passes.1 > total {
-        bail!(
-            "--pass-range {}..{} goes past the {total} passes of the render (set --spp)",
-            passes.0,
-            passes.1
-        );
-    }
-    let kind = setup.integrator.kind();
-    if args.pass_range.is_some() && !kind.independent_passes() {
-        bail!("--pass-range: {kind}'s passes depend on each other and cannot be split (use ppm, or --checkpoint and --resume)");
-    }
-    let fp = render::fingerprint(&desc, &ov, setup.film.layout());
-    let mut state = match &args.resume {
-        Some(path) => resumed(path, fp, total, kind)?,
-        None => render::new_state(&setup, fp, total, &settings_text(&ov)),
-    };
-    let partial = args.pass_range.map(|(a, b)| {
-        args.checkpoint
-            .clone()
-            .unwrap_or_else(|| exr.with_extension(format!("passes-{a}-{b}.cndl")))
-    });
-    let checkpoint = partial
-        .clone()
-        .or_else(|| args.checkpoint.clone())
-        .unwrap_or_else(|| exr.with_extension("cndl"));
-    let opts = RenderOptions {
-        passes,
-        time_limit: args.time_limit.map(Duration::from_secs_f64),
-        target_error: args.target_error,
-        checkpoint: Some(checkpoint.clone()),
-        checkpoint_every: args.checkpoint_every.map(Duration::from_secs_f64),
-    };
+    let (mut state, opts, partial) = plan(&args, &desc, &setup, &ov, &exr)?;
+    let checkpoint = opts.checkpoint.clone().unwrap_or_default();
     let load_time = t0.elapsed();
     let display = progress::display(args.quiet);
     let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |_| {})?;
@@ -295,6 +263,52 @@ pub fn render(args: RenderArgs) -> Result<i32> {
             0
         },
     )
+}
+
+/// The state to start from, the loop's options and the partial-state path
+/// (with `--pass-range`) of a render.
+fn plan(
+    args: &RenderArgs,
+    desc: &candela_scene::SceneDescription,
+    setup: &RenderSetup,
+    ov: &Overrides,
+    exr: &Path,
+) -> Result<(RenderState, RenderOptions, Option<PathBuf>)> {
+    let total = setup.sampler.samples_per_pixel() as u64;
+    let passes = args.pass_range.unwrap_or((0, total));
+    if passes.1 > total {
+        bail!(
+            "--pass-range {}..{} goes past the {total} passes of the render (set --spp)",
+            passes.0,
+            passes.1
+        );
+    }
+    let kind = setup.integrator.kind();
+    if args.pass_range.is_some() && !kind.independent_passes() {
+        bail!("--pass-range: {kind}'s passes depend on each other and cannot be split (use ppm, or --checkpoint and --resume)");
+    }
+    let fp = render::fingerprint(desc, ov, setup.film.layout());
+    let state = match &args.resume {
+        Some(path) => resumed(path, fp, total, kind)?,
+        None => render::new_state(setup, fp, total, &settings_text(ov)),
+    };
+    let partial = args.pass_range.map(|(a, b)| {
+        args.checkpoint
+            .clone()
+            .unwrap_or_else(|| exr.with_extension(format!("passes-{a}-{b}.cndl")))
+    });
+    let checkpoint = partial
+        .clone()
+        .or_else(|| args.checkpoint.clone())
+        .unwrap_or_else(|| exr.with_extension("cndl"));
+    let opts = RenderOptions {
+        passes,
+        time_limit: args.time_limit.map(Duration::from_secs_f64),
+        target_error: args.target_error,
+        checkpoint: Some(checkpoint),
+        checkpoint_every: args.checkpoint_every.map(Duration::from_secs_f64),
+    };
+    Ok((state, opts, partial))
 }
 
 /// The state in checkpoint `path`, checked against this render.

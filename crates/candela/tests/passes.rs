@@ -223,7 +223,13 @@ fn sigint_writes_image_and_checkpoint_and_resume_gives_the_uninterrupted_bytes()
         "resumed render differs from an uninterrupted one"
     );
 
-    // A checkpoint of another scene, of other flags, or truncated, is refused.
+    refusals(&d, &s, &ckpt, &args);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A checkpoint of another scene, of other flags, truncated or not a
+/// checkpoint at all is refused with a message, and no image is written.
+fn refusals(d: &Path, s: &Path, ckpt: &Path, args: &[&str]) {
     let other = d.join("other.pbrt");
     std::fs::write(&other, scene(r#""path" "integer maxdepth" [4]"#)).unwrap();
     let refuse = |scene: &Path, ckpt: &Path, extra: &[&str], word: &str| {
@@ -245,18 +251,12 @@ fn sigint_writes_image_and_checkpoint_and_resume_gives_the_uninterrupted_bytes()
             "a refused resume wrote an image"
         );
     };
-    refuse(&other, &ckpt, &args, "another scene");
-    refuse(
-        &s,
-        &ckpt,
-        &["--spp", "4000", "--seed", "3"],
-        "another scene",
-    );
+    refuse(&other, ckpt, args, "another scene");
+    refuse(s, ckpt, &["--spp", "4000", "--seed", "3"], "another scene");
     let cut = d.join("cut.cndl");
-    let full = bytes(&ckpt);
+    let full = bytes(ckpt);
     std::fs::write(&cut, &full[..full.len() / 2]).unwrap();
-    refuse(&s, &cut, &args, "truncated or damaged");
+    refuse(s, &cut, args, "truncated or damaged");
     std::fs::write(&cut, b"not a checkpoint at all, just text").unwrap();
-    refuse(&s, &cut, &args, "not a candela render state");
-    std::fs::remove_dir_all(&d).ok();
+    refuse(s, &cut, args, "not a candela render state");
 }

@@ -215,27 +215,13 @@ impl Bvh {
         let mut current = 0u32;
         loop {
             if current & LEAF_TAG == 0 {
-                let node = &self.nodes[current as usize];
-                let (mut mask, t_near) = boxes.hits(node, t_max);
-                let t_near = t_near.to_array();
-                // Hit children, nearest first (insertion sort).
                 let mut order = [(0u32, 0.0f32); WIDTH];
-                let mut k = 0;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if node.child[i] == EMPTY_CHILD {
-                        continue; // Only for rays with non-finite parts.
-                    }
-                    let entry = (node.child[i], t_near[i]);
-                    let mut j = k;
-                    while j > 0 && order[j - 1].1 > entry.1 {
-                        order[j] = order[j - 1];
-                        j -= 1;
-                    }
-                    order[j] = entry;
-                    k += 1;
-                }
+                let k = hit_children_nearest_first(
+                    &self.nodes[current as usize],
+                    &boxes,
+                    t_max,
+                    &mut order,
+                );
                 if k > 0 {
                     for &e in order[1..k].iter().rev() {
                         stack[sp] = e;
@@ -468,4 +454,34 @@ impl<T: Fn(u32) -> Option<[Vec3; 3]>> Collapse<'_, T> {
         );
         LEAF_TAG | ((n as u32 - 1) << 28) | start as u32
     }
+}
+
+/// Writes the children of `node` that the ray hits before `t_max` into
+/// `order`, nearest first (insertion sort over at most 8), and returns how many.
+#[inline(always)]
+fn hit_children_nearest_first(
+    node: &Node,
+    boxes: &RayBoxes,
+    t_max: f32,
+    order: &mut [(u32, f32); WIDTH],
+) -> usize {
+    let (mut mask, t_near) = boxes.hits(node, t_max);
+    let t_near = t_near.to_array();
+    let mut k = 0;
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        if node.child[i] == EMPTY_CHILD {
+            continue; // Only for rays with non-finite parts.
+        }
+        let entry = (node.child[i], t_near[i]);
+        let mut j = k;
+        while j > 0 && order[j - 1].1 > entry.1 {
+            order[j] = order[j - 1];
+            j -= 1;
+        }
+        order[j] = entry;
+        k += 1;
+    }
+    k
 }

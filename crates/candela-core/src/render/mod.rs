@@ -164,6 +164,11 @@ pub fn check_options(
     opts: &RenderOptions,
 ) -> Result<(), RenderError> {
     let kind = setup.integrator.kind();
+    if state.film.layout != *setup.film.layout() || state.film.pixels != setup.film.pixel_count() {
+        return Err(RenderError::Options(
+            "the state is of a film with other pixel bounds or layers".into(),
+        ));
+    }
     if state.integrator != kind.name() {
         return Err(RenderError::Options(format!(
             "the state is of a \"{}\" render, not \"{}\"",
