@@ -5,6 +5,7 @@ use crate::progress;
 use anyhow::{bail, Context, Result};
 use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::film::develop::develop;
+use candela_core::film::Aov;
 use candela_core::integrator::{IntegratorKind, Visualize};
 use candela_core::render::{self, RenderOptions, RenderState, StopReason};
 use std::path::{Path, PathBuf};
@@ -111,6 +112,29 @@ pub struct RenderArgs {
     /// channel, from the spread of the per-pass means) is below this.
     #[arg(long, value_parser = parse_error)]
     pub target_error: Option<f64>,
+    /// Extra EXR layers, comma-separated. First-hit values (of each pass's
+    /// camera ray, followed through interface materials to the first
+    /// surface with a BSDF; filter-weighted averages, rays that escape
+    /// count as 0): `albedo` (albedo.R/G/B: directional reflectance ρ(wo)
+    /// times the colour space's illuminant, output RGB), `position`
+    /// (position.X/Y/Z, world space), `normal` and `shading_normal`
+    /// (normal.X/Y/Z, shading_normal.X/Y/Z: unit, world space, facing the
+    /// camera), `depth` (depth.Z: distance from the lens point), `uv`
+    /// (uv.U/V: surface coordinates), `dzdxy` (dzdx, dzdy: |change of
+    /// camera-space z| per pixel). `variance` (variance.R/G/B): variance of
+    /// each pixel's value, from the spread of the independent passes
+    /// (s²/n; needs 2 passes).
+    #[arg(long, value_parser = parse_aovs)]
+    pub aov: Option<AovList>,
+}
+
+/// The layers of `--aov` (one value to clap, not a list of values).
+#[derive(Clone, Debug)]
+pub struct AovList(Vec<Aov>);
+
+/// Parses an `--aov` list.
+fn parse_aovs(s: &str) -> Result<AovList, String> {
+    Aov::parse_list(s).map(AovList)
 }
 
 impl RenderArgs {
@@ -122,6 +146,7 @@ impl RenderArgs {
             outfile: self.outfile.clone(),
             seed: self.seed,
             cropwindow: self.cropwindow,
+            aovs: self.aov.clone().map(|a| a.0).unwrap_or_default(),
         }
     }
 }
@@ -154,6 +179,9 @@ fn settings_text(ov: &Overrides) -> String {
     if let Some([a, b, c, d]) = ov.cropwindow {
         s.push_str(&format!("cropwindow={a:?},{b:?},{c:?},{d:?}\n"));
     }
+    if !ov.aovs.is_empty() {
+        s.push_str(&format!("aov={}\n", Aov::list_text(&ov.aovs)));
+    }
     s
 }
 
@@ -171,6 +199,7 @@ fn overrides_from(text: &str) -> Result<Overrides> {
             "cropwindow" => {
                 ov.cropwindow = Some(parse_cropwindow(v).map_err(anyhow::Error::msg)?);
             }
+            "aov" => ov.aovs = Aov::parse_list(v).map_err(anyhow::Error::msg)?,
             _ => bail!("unknown setting {k:?} in the state file"),
         }
     }
