@@ -340,3 +340,62 @@ Shape "sphere" "float radius" [0.2]
         );
     }
 }
+
+/// The variance layer (s²/n of a pixel's n pass values) against the spread
+/// of 24 independent renders of the same pixel: both estimate the variance
+/// of the pixel's value without bias (the independent sampler makes the
+/// passes i.i.d.). Per pixel, d = (variance across renders) − (mean of the
+/// layer over renders); the mean of d over the independent pixels must be
+/// within 5σ of 0, σ the standard error from the spread of d; and that σ
+/// must be small against the variance itself, or the test could not see
+/// a factor-of-n error.
+#[test]
+fn variance_layer_matches_the_spread_of_independent_renders() {
+    let text = r#"LookAt 0 2 -2  0 0 0  0 1 0
+Camera "perspective" "float fov" [50]
+Film "rgb" "integer xresolution" [16] "integer yresolution" [16]
+Sampler "independent"
+Integrator "path" "integer maxdepth" [2]
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [20 20 20]
+  Translate 0 1.5 0
+  Shape "trianglemesh" "point3 P" [-0.2 0 -0.2  0.2 0 -0.2  0.2 0 0.2  -0.2 0 0.2] "integer indices" [0 1 2 0 2 3]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "point3 P" [-4 0 -4  4 0 -4  4 0 4  -4 0 4] "integer indices" [0 1 2 0 2 3]
+"#;
+    let k = 24;
+    let renders: Vec<Developed> = (0..k)
+        .map(|seed| {
+            let o = Overrides {
+                seed: Some(100 + seed),
+                ..ov("variance", 8)
+            };
+            developed(text, &o)
+        })
+        .collect();
+    let n = 16 * 16;
+    let (mut d, mut v_mean) = (Vec::with_capacity(n), 0.0);
+    for i in 0..n {
+        let r: Vec<f64> = renders
+            .iter()
+            .map(|dev| dev.channels[0].data[i] as f64)
+            .collect();
+        let m = r.iter().sum::<f64>() / k as f64;
+        let spread = r.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (k - 1) as f64;
+        let layer = renders
+            .iter()
+            .map(|dev| channel(dev, "variance.R")[i] as f64)
+            .sum::<f64>()
+            / k as f64;
+        d.push((spread - layer) as f32);
+        v_mean += layer / n as f64;
+    }
+    let (md, sd) = mean_se(&d);
+    assert!(
+        md.abs() <= 5.0 * sd,
+        "spread − layer = {md} ± {sd} (variance {v_mean})"
+    );
+    assert!(sd < 0.1 * v_mean, "too noisy to test: {sd} vs {v_mean}");
+}

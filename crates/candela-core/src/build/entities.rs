@@ -141,12 +141,14 @@ fn film_layers(
             };
             (layout, FilmKind::Spectral, SurfaceSpace::World)
         }
-        other => return Err(BuildError::at(
-            &e.loc,
-            format!(
+        other => {
+            return Err(BuildError::at(
+                &e.loc,
+                format!(
                 "film \"{other}\" is not supported (supported: \"rgb\", \"gbuffer\", \"spectral\")"
             ),
-        )),
+            ))
+        }
     };
     Ok((layout.with_aovs(&ov.aovs), kind, space))
 }
