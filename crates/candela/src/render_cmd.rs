@@ -1,5 +1,6 @@
 //! `candela render` and `candela merge`: flags → render loop → outputs.
 
+use crate::live::Live;
 use crate::output;
 use crate::progress;
 use anyhow::{bail, Context, Result};
@@ -126,6 +127,12 @@ pub struct RenderArgs {
     /// (s²/n; needs 2 passes).
     #[arg(long, value_parser = parse_aovs)]
     pub aov: Option<AovList>,
+    /// Show the image in the tev viewer listening at HOST:PORT while it
+    /// renders (tev's default is 127.0.0.1:14158): every channel of the
+    /// EXR, at most 4 frames a second, never blocking the render; the
+    /// final image is always sent.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub display_server: Option<String>,
 }
 
 /// The layers of `--aov` (one value to clap, not a list of values).
@@ -295,7 +302,21 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     };
     let load_time = t0.elapsed();
     let display = progress::display(args.quiet);
-    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |_| {})?;
+    let name = args
+        .scene
+        .file_name()
+        .map_or("candela".into(), |n| n.to_string_lossy().to_string());
+    let mut live = args
+        .display_server
+        .as_deref()
+        .map(|a| Live::start(a, &name))
+        .transpose()?;
+    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |st| {
+        if let Some(l) = live.as_mut() {
+            l.after_pass(&setup, st);
+        }
+    })?;
+    let live_report = live.map(|l| l.finish(&setup, &state));
     write_image(&setup, &state, &exr)?;
     let stopped_early = outcome.reason != StopReason::Finished;
     let write_state = partial.is_some() || args.checkpoint.is_some() || stopped_early;
@@ -317,6 +338,14 @@ pub fn render(args: RenderArgs) -> Result<i32> {
         &exr,
         write_state.then_some(&checkpoint),
     );
+    if let (Some(r), false) = (live_report, args.quiet) {
+        eprintln!(
+            "candela: live view: {} frames ({} delivered), {:.1} ms each to develop",
+            r.frames,
+            r.delivered,
+            r.mean_build.as_secs_f64() * 1e3
+        );
+    }
     Ok(
         if outcome.reason == StopReason::Interrupted || stop.load(Ordering::Relaxed) {
             EXIT_INTERRUPTED

@@ -148,8 +148,18 @@ fn uneven_pass_ranges_merge_into_the_bytes_of_one_run_for_every_integrator() {
 #[test]
 fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
     let cases = [
-        ("aov-path", r#""path" "integer maxdepth" [5]"#, "rgb", "albedo,depth,normal,uv,dzdxy,variance"),
-        ("aov-ppm", INTEGRATORS[3].1, "rgb", "position,shading_normal,variance"),
+        (
+            "aov-path",
+            r#""path" "integer maxdepth" [5]"#,
+            "rgb",
+            "albedo,depth,normal,uv,dzdxy,variance",
+        ),
+        (
+            "aov-ppm",
+            INTEGRATORS[3].1,
+            "rgb",
+            "position,shading_normal,variance",
+        ),
         ("gbuffer-bdpt", INTEGRATORS[2].1, "gbuffer", ""),
         ("spectral-lightpath", INTEGRATORS[1].1, "spectral", "albedo"),
     ];
@@ -177,9 +187,16 @@ fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
             .arg(d.join("merged.exr"))
             .output()
             .unwrap();
-        assert!(o.status.success(), "{name}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         let full = bytes(&d.join("full.exr"));
-        assert!(bytes(&d.join("merged.exr")) == full, "{name}: merged EXR differs from one run");
+        assert!(
+            bytes(&d.join("merged.exr")) == full,
+            "{name}: merged EXR differs from one run"
+        );
         let layers = candela_core::image::read_exr_layers(&d.join("full.exr")).unwrap();
         assert!(layers.layers.len() > 1, "{name}: no layers written");
         std::fs::remove_dir_all(&d).ok();
