@@ -1,10 +1,12 @@
 //! `candela render` and `candela merge`: flags → render loop → outputs.
 
+use crate::live::Live;
 use crate::output;
 use crate::progress;
 use anyhow::{bail, Context, Result};
 use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::film::develop::develop;
+use candela_core::film::Aov;
 use candela_core::integrator::{IntegratorKind, Visualize};
 use candela_core::render::{self, RenderOptions, RenderState, StopReason};
 use std::path::{Path, PathBuf};
@@ -111,6 +113,35 @@ pub struct RenderArgs {
     /// channel, from the spread of the per-pass means) is below this.
     #[arg(long, value_parser = parse_error)]
     pub target_error: Option<f64>,
+    /// Extra EXR layers, comma-separated. First-hit values (of each pass's
+    /// camera ray, followed through interface materials to the first
+    /// surface with a BSDF; filter-weighted averages, rays that escape
+    /// count as 0): `albedo` (albedo.R/G/B: directional reflectance ρ(wo)
+    /// times the colour space's illuminant, output RGB), `position`
+    /// (position.X/Y/Z, world space), `normal` and `shading_normal`
+    /// (normal.X/Y/Z, shading_normal.X/Y/Z: unit, world space, facing the
+    /// camera), `depth` (depth.Z: distance from the lens point), `uv`
+    /// (uv.U/V: surface coordinates), `dzdxy` (dzdx, dzdy: |change of
+    /// camera-space z| per pixel). `variance` (variance.R/G/B): variance of
+    /// each pixel's value, from the spread of the independent passes
+    /// (s²/n; needs 2 passes).
+    #[arg(long, value_parser = parse_aovs)]
+    pub aov: Option<AovList>,
+    /// Show the image in the tev viewer listening at HOST:PORT while it
+    /// renders (tev's default is 127.0.0.1:14158): every channel of the
+    /// EXR, at most 4 frames a second, never blocking the render; the
+    /// final image is always sent.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub display_server: Option<String>,
+}
+
+/// The layers of `--aov` (one value to clap, not a list of values).
+#[derive(Clone, Debug)]
+pub struct AovList(Vec<Aov>);
+
+/// Parses an `--aov` list.
+fn parse_aovs(s: &str) -> Result<AovList, String> {
+    Aov::parse_list(s).map(AovList)
 }
 
 impl RenderArgs {
@@ -122,6 +153,7 @@ impl RenderArgs {
             outfile: self.outfile.clone(),
             seed: self.seed,
             cropwindow: self.cropwindow,
+            aovs: self.aov.clone().map(|a| a.0).unwrap_or_default(),
         }
     }
 }
@@ -154,6 +186,9 @@ fn settings_text(ov: &Overrides) -> String {
     if let Some([a, b, c, d]) = ov.cropwindow {
         s.push_str(&format!("cropwindow={a:?},{b:?},{c:?},{d:?}\n"));
     }
+    if !ov.aovs.is_empty() {
+        s.push_str(&format!("aov={}\n", Aov::list_text(&ov.aovs)));
+    }
     s
 }
 
@@ -171,6 +206,7 @@ fn overrides_from(text: &str) -> Result<Overrides> {
             "cropwindow" => {
                 ov.cropwindow = Some(parse_cropwindow(v).map_err(anyhow::Error::msg)?);
             }
+            "aov" => ov.aovs = Aov::parse_list(v).map_err(anyhow::Error::msg)?,
             _ => bail!("unknown setting {k:?} in the state file"),
         }
     }
@@ -234,7 +270,21 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     let checkpoint = opts.checkpoint.clone().unwrap_or_default();
     let load_time = t0.elapsed();
     let display = progress::display(args.quiet);
-    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |_| {})?;
+    let name = args
+        .scene
+        .file_name()
+        .map_or("candela".into(), |n| n.to_string_lossy().to_string());
+    let mut live = args
+        .display_server
+        .as_deref()
+        .map(|a| Live::start(a, &name))
+        .transpose()?;
+    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |st| {
+        if let Some(l) = live.as_mut() {
+            l.after_pass(&setup, st);
+        }
+    })?;
+    let live_report = live.map(|l| l.finish(&setup, &state));
     write_image(&setup, &state, &exr)?;
     let stopped_early = outcome.reason != StopReason::Finished;
     let write_state = partial.is_some() || args.checkpoint.is_some() || stopped_early;
@@ -256,6 +306,14 @@ pub fn render(args: RenderArgs) -> Result<i32> {
         &exr,
         write_state.then_some(&checkpoint),
     );
+    if let (Some(r), false) = (live_report, args.quiet) {
+        eprintln!(
+            "candela: live view: {} frames ({} delivered), {:.1} ms each to develop",
+            r.frames,
+            r.delivered,
+            r.mean_build.as_secs_f64() * 1e3
+        );
+    }
     Ok(
         if outcome.reason == StopReason::Interrupted || stop.load(Ordering::Relaxed) {
             EXIT_INTERRUPTED

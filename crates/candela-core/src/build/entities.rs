@@ -3,10 +3,10 @@
 use super::{BuildError, Overrides};
 use crate::camera::{Camera, CameraParams, SphericalCamera, SphericalMapping};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
-use crate::film::{Film, FilmSettings};
+use crate::film::{Buckets, Film, FilmKind, FilmLayout, FilmSettings, SurfaceAov, SurfaceSpace};
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
-use crate::spectrum::{ColorSpace, PixelSensor};
+use crate::spectrum::{ColorSpace, PixelSensor, LAMBDA_MAX, LAMBDA_MIN};
 use candela_scene::SceneDescription;
 use std::path::PathBuf;
 
@@ -19,34 +19,11 @@ fn transform(
 }
 
 /// The film and the output path (`--outfile` over `"string filename"`).
-pub fn film(
-    desc: &SceneDescription,
-    ov: &Overrides,
-    warnings: &mut Vec<String>,
-) -> Result<(Film, PathBuf), BuildError> {
+pub fn film(desc: &SceneDescription, ov: &Overrides) -> Result<(Film, PathBuf), BuildError> {
     let empty = super::default_entity("rgb");
     let e = desc.film.as_ref().unwrap_or(&empty);
     let p = &e.params;
-    match e.name.as_str() {
-        "rgb" => {}
-        // Same RGB image as "rgb"; the extra outputs are left out.
-        "gbuffer" => {
-            let _ = p.get_string("coordinatesystem", "camera")?;
-            warnings.push(format!("{}: film \"gbuffer\" is written as \"rgb\": the auxiliary channels (albedo, normals, depth, variance) are not written", e.loc));
-        }
-        "spectral" => {
-            let _ = p.get_int("nbuckets", 16)?;
-            let _ = p.get_float("lambdamin", 360.0)?;
-            let _ = p.get_float("lambdamax", 830.0)?;
-            warnings.push(format!("{}: film \"spectral\" is written as \"rgb\": the spectral channels are not written", e.loc));
-        }
-        other => {
-            return Err(BuildError::at(
-                &e.loc,
-                format!("film \"{other}\" is not supported (supported: \"rgb\"; \"gbuffer\" and \"spectral\" are written as \"rgb\")"),
-            ))
-        }
-    }
+    let (layout, kind, space) = film_layers(e, ov)?;
     let res = UVec2::new(
         p.get_int("xresolution", 1280)?.max(1) as u32,
         p.get_int("yresolution", 720)?.max(1) as u32,
@@ -94,10 +71,86 @@ pub fn film(
         pixel_bounds,
         max_component_value,
     };
-    Ok((
-        Film::new(settings, filter, sensor, output_from_sensor),
-        outfile,
-    ))
+    let film = Film::new(settings, filter, sensor, output_from_sensor)
+        .with_layers(layout, kind, space)
+        .with_color_space(cs);
+    Ok((film, outfile))
+}
+
+/// Longest list of spectral buckets (each costs two sums per pixel).
+const MAX_BUCKETS: i32 = 1024;
+
+/// The layers of the `Film` directive's kind [pbrt-v4 `GBufferFilm`,
+/// `SpectralFilm`] and of `--aov`.
+fn film_layers(
+    e: &candela_scene::Entity,
+    ov: &Overrides,
+) -> Result<(FilmLayout, FilmKind, SurfaceSpace), BuildError> {
+    let p = &e.params;
+    let (layout, kind, space) = match e.name.as_str() {
+        "rgb" => (FilmLayout::default(), FilmKind::Rgb, SurfaceSpace::World),
+        "gbuffer" => {
+            let space = match p.get_string("coordinatesystem", "camera")?.as_str() {
+                "camera" => SurfaceSpace::Camera,
+                "world" => SurfaceSpace::World,
+                other => {
+                    let loc = p.param_loc("coordinatesystem").unwrap_or(&e.loc);
+                    return Err(BuildError::at(
+                        loc,
+                        format!("\"coordinatesystem\" must be \"camera\" or \"world\", found \"{other}\""),
+                    ));
+                }
+            };
+            use SurfaceAov::*;
+            let layout = FilmLayout {
+                surface: vec![Albedo, Position, DepthGradient, Normal, ShadingNormal, Uv],
+                variance: true,
+                ..FilmLayout::default()
+            };
+            (layout, FilmKind::GBuffer, space)
+        }
+        "spectral" => {
+            let n = p.get_int("nbuckets", 16)?;
+            let (lo, hi) = (
+                p.get_float("lambdamin", 360.0)?,
+                p.get_float("lambdamax", 830.0)?,
+            );
+            if !(1..=MAX_BUCKETS).contains(&n) {
+                let loc = p.param_loc("nbuckets").unwrap_or(&e.loc);
+                return Err(BuildError::at(
+                    loc,
+                    format!("\"nbuckets\" must be between 1 and {MAX_BUCKETS}, found {n}"),
+                ));
+            }
+            if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lo)
+                || !(LAMBDA_MIN..=LAMBDA_MAX).contains(&hi)
+                || lo >= hi
+            {
+                return Err(BuildError::at(
+                    &e.loc,
+                    format!("\"lambdamin\" {lo} and \"lambdamax\" {hi} must satisfy {LAMBDA_MIN} ≤ lambdamin < lambdamax ≤ {LAMBDA_MAX} nm (the wavelengths candela samples)"),
+                ));
+            }
+            let layout = FilmLayout {
+                spectral: Some(Buckets {
+                    n: n as usize,
+                    lambda_min: lo,
+                    lambda_max: hi,
+                }),
+                ..FilmLayout::default()
+            };
+            (layout, FilmKind::Spectral, SurfaceSpace::World)
+        }
+        other => {
+            return Err(BuildError::at(
+                &e.loc,
+                format!(
+                "film \"{other}\" is not supported (supported: \"rgb\", \"gbuffer\", \"spectral\")"
+            ),
+            ))
+        }
+    };
+    Ok((layout.with_aovs(&ov.aovs), kind, space))
 }
 
 fn camera_exposure(desc: &SceneDescription) -> Result<f32, BuildError> {

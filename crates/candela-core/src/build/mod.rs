@@ -21,7 +21,7 @@ pub use integrators::{kind_from_name, INTEGRATOR_NAMES};
 pub use summary::{summarize, Counts, SceneSummary};
 
 use crate::camera::{Camera, PixelFootprint};
-use crate::film::{Film, FilmKind, FilmLayout, SurfaceSpace};
+use crate::film::{Film, FilmLayout};
 use crate::integrator::{Integrator, IntegratorKind};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -82,6 +82,8 @@ pub struct Overrides {
     /// `--cropwindow x0,x1,y0,y1` (pbrt-v4's; replaces the film's
     /// `cropwindow` and `pixelbounds`).
     pub cropwindow: Option<[f32; 4]>,
+    /// `--aov`: extra film layers.
+    pub aovs: Vec<crate::film::Aov>,
 }
 
 /// Everything needed to render.
@@ -109,7 +111,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .iter()
         .map(|w| format!("{}: {}", w.loc, w.message))
         .collect();
-    let (film, outfile) = entities::film(desc, ov, &mut warnings)?;
+    let (film, outfile) = entities::film(desc, ov)?;
     let camera = entities::camera(desc, &film)?;
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let built = integrators::integrator(desc, ov, &mut warnings)?;
@@ -119,7 +121,8 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
             strategies: built.strategy_layers,
             ..film.layout().clone()
         };
-        film.with_layers(layout, FilmKind::Rgb, SurfaceSpace::World)
+        let (kind, space) = (film.kind(), film.surface_space());
+        film.with_layers(layout, kind, space)
     } else {
         film
     };

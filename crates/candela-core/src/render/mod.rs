@@ -6,6 +6,7 @@
 //! for pass in passes not yet in the state {
 //!     stop requested, time or error budget spent?  → stop
 //!     integrator.render_pass(ctx, pass, &mut integrator_state, &mut block)
+//!     surface::render_surface_pass(ctx, pass, &mut block)   (first-hit layers, if any)
 //!     film_state.add_pass(pass, block)            (exact, fixed point)
 //!     on_pass(state)                              (live view, …)
 //!     checkpoint if due
@@ -26,6 +27,7 @@
 
 mod fingerprint;
 mod state;
+pub mod surface;
 
 pub use fingerprint::fingerprint;
 pub use state::{RenderState, StateError};
@@ -177,6 +179,17 @@ pub fn check_options(
         )));
     }
     if kind == IntegratorKind::Sppm {
+        let layout = setup.film.layout();
+        if layout.spectral.is_some() {
+            return Err(RenderError::Options(
+                "Film \"spectral\" cannot be rendered with sppm: its radiance estimate τ is accumulated in RGB (use ppm, whose passes fill the spectral buckets)".into(),
+            ));
+        }
+        if layout.variance {
+            return Err(RenderError::Options(
+                "the variance layer (--aov variance, Film \"gbuffer\") needs independent passes; SPPM's iterations depend on each other (use ppm)".into(),
+            ));
+        }
         if opts.target_error.is_some() {
             return Err(RenderError::Options(
                 "--target-error needs independent passes; SPPM's iterations depend on each other (use ppm)".into(),
@@ -284,6 +297,11 @@ fn run_passes(
                 .integrator
                 .render_pass(ctx, pass, &mut state.integrator_state, &mut block);
         if outcome == PassOutcome::Cancelled {
+            return Ok((StopReason::Interrupted, rendered));
+        }
+        if !setup.film.layout().surface.is_empty()
+            && surface::render_surface_pass(ctx, pass, &mut block) == PassOutcome::Cancelled
+        {
             return Ok((StopReason::Interrupted, rendered));
         }
         state.film.add_pass(&setup.film, pass, &block);
