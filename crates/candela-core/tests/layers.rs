@@ -268,7 +268,16 @@ fn gbuffer_channels_and_coordinate_systems() {
             "gbuffer channel {c} differs from rgb"
         );
     }
-    let bad = scene("screen");
+}
+
+/// An unknown `coordinatesystem` is refused with its location and value.
+#[test]
+fn gbuffer_refuses_an_unknown_coordinate_system() {
+    let bad = plane_scene(
+        r#""perspective" "float fov" [60]"#,
+        r#""gbuffer" "string coordinatesystem" "screen""#,
+        0.0,
+    );
     let desc = candela_scene::parse_str(&bad, Path::new("layers.pbrt")).expect("parses");
     let e = build(&desc, &ov("", 1))
         .err()
