@@ -111,6 +111,11 @@ pub struct RenderArgs {
     /// channel, from the spread of the per-pass means) is below this.
     #[arg(long, value_parser = parse_error)]
     pub target_error: Option<f64>,
+    /// Refuse to start a render whose film, photon and other large
+    /// structures are estimated above this size ("4G", "512MiB", "50%";
+    /// default: 75% of physical memory).
+    #[arg(long, value_parser = candela_core::build::parse_memory)]
+    pub memory_limit: Option<u64>,
 }
 
 impl RenderArgs {
@@ -122,6 +127,7 @@ impl RenderArgs {
             outfile: self.outfile.clone(),
             seed: self.seed,
             cropwindow: self.cropwindow,
+            memory_limit: self.memory_limit,
         }
     }
 }
