@@ -133,6 +133,11 @@ pub struct RenderArgs {
     /// final image is always sent.
     #[arg(long, value_name = "HOST:PORT")]
     pub display_server: Option<String>,
+    /// Refuse to start a render whose film, photon and other large
+    /// structures are estimated above this size ("4G", "512MiB", "50%";
+    /// default: 75% of physical memory).
+    #[arg(long, value_parser = candela_core::build::parse_memory)]
+    pub memory_limit: Option<u64>,
 }
 
 /// The layers of `--aov` (one value to clap, not a list of values).
@@ -154,6 +159,7 @@ impl RenderArgs {
             seed: self.seed,
             cropwindow: self.cropwindow,
             aovs: self.aov.clone().map(|a| a.0).unwrap_or_default(),
+            memory_limit: self.memory_limit,
         }
     }
 }
