@@ -122,6 +122,17 @@ pub fn primitives(
     })
 }
 
+/// The material a shape refers to (named ones must be defined).
+fn material_of(s: &ShapeDesc, names: &MaterialNames) -> Result<MaterialId, BuildError> {
+    Ok(match &s.material {
+        MaterialRef::Index(i) => MaterialId(*i as u32),
+        MaterialRef::Named(n) => *names.0.get(n).ok_or_else(|| {
+            BuildError::at(&s.loc, format!("named material \"{n}\" is not defined"))
+        })?,
+        MaterialRef::None => names.1,
+    })
+}
+
 fn add_shape(
     s: &ShapeDesc,
     parent: &Placement,
@@ -130,13 +141,7 @@ fn add_shape(
     sink: &mut Sink<'_>,
     warnings: &mut Vec<String>,
 ) -> Result<(), BuildError> {
-    let material = match &s.material {
-        MaterialRef::Index(i) => Some(MaterialId(*i as u32)),
-        MaterialRef::Named(n) => Some(*names.0.get(n).ok_or_else(|| {
-            BuildError::at(&s.loc, format!("named material \"{n}\" is not defined"))
-        })?),
-        MaterialRef::None => Some(names.1),
-    };
+    let material = Some(material_of(s, names)?);
     let Some(object) = Transform::from_rows_f64(s.render_from_object.m) else {
         warnings.push(singular(&s.loc, "shape"));
         s.params.mark_all_used();

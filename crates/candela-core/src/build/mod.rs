@@ -132,16 +132,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let default_integrator = default_entity("volpath");
     let plan = integrators::integrator(desc, ov, &default_integrator, &mut warnings)?;
-    let film = if plan.strategy_layers > 0 {
-        let layout = FilmLayout {
-            strategies: plan.strategy_layers,
-            ..film.layout().clone()
-        };
-        let (kind, space) = (film.kind(), film.surface_space());
-        film.with_layers(layout, kind, space)
-    } else {
-        film
-    };
+    let film = with_strategy_layers(film, plan.strategy_layers);
     claim_film(desc, &film, &mut budget)?;
     let kind = plan.kind();
     if kind == IntegratorKind::LightPath && !camera.is_connectable() {
@@ -199,6 +190,19 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         warnings,
         budget,
     })
+}
+
+/// The film with `n` strategy layers added (BDPT's visualisation).
+fn with_strategy_layers(film: Film, n: usize) -> Film {
+    if n == 0 {
+        return film;
+    }
+    let layout = FilmLayout {
+        strategies: n,
+        ..film.layout().clone()
+    };
+    let (kind, space) = (film.kind(), film.surface_space());
+    film.with_layers(layout, kind, space)
 }
 
 /// Claims the film's memory; past the limit, the error is at the Film
