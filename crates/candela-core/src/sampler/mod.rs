@@ -149,3 +149,15 @@ fn sample_from_bits(v: u32) -> f32 {
 
 #[cfg(test)]
 mod tests;
+
+/// The sampler serves camera-driven path walks [`crate::sampling::PathRng`].
+impl crate::sampling::PathRng for Sampler {
+    #[inline]
+    fn u1(&mut self) -> f32 {
+        self.get_1d()
+    }
+    #[inline]
+    fn u2(&mut self) -> crate::math::Vec2 {
+        self.get_2d()
+    }
+}

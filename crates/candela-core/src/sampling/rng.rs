@@ -9,7 +9,6 @@
 
 use super::hash_u64s;
 use crate::math::Vec2;
-use crate::sampler::Sampler;
 
 /// Uniform numbers in [0, 1) for a path walk, one or two at a time.
 pub trait PathRng {
@@ -17,17 +16,6 @@ pub trait PathRng {
     fn u1(&mut self) -> f32;
     /// The next two numbers (a 2D sample of the sampler).
     fn u2(&mut self) -> Vec2;
-}
-
-impl PathRng for Sampler {
-    #[inline]
-    fn u1(&mut self) -> f32 {
-        self.get_1d()
-    }
-    #[inline]
-    fn u2(&mut self) -> Vec2 {
-        self.get_2d()
-    }
 }
 
 /// The numbers of path `index` of `pass`: PCG32 seeded by hash(seed, pass, index).
@@ -39,7 +27,7 @@ impl StreamRng {
     pub fn new(seed: u64, pass: u64, index: u64) -> Self {
         Self(Pcg32::new(hash_u64s(&[seed, pass, index]), 0))
     }
-    /// TEMPORARY: a stream from a precomputed hash.
+    /// A stream from a precomputed hash of its (seed, pass, index).
     pub fn with_hash(h: u64) -> Self {
         Self(Pcg32::new(h, 0))
     }
