@@ -62,6 +62,18 @@ pub fn kind_from_name(name: &str) -> Option<(IntegratorKind, bool)> {
     })
 }
 
+/// True for the integrators whose defaults depend on the scene's scale
+/// (the photon integrators and VCM: their radius).
+pub fn needs_scale(kind: IntegratorKind) -> bool {
+    matches!(
+        kind,
+        IntegratorKind::Sppm
+            | IntegratorKind::Ppm
+            | IntegratorKind::PhotonMap
+            | IntegratorKind::Vcm
+    )
+}
+
 /// Names accepted by [`kind_from_name`].
 pub const INTEGRATOR_NAMES: &str = "path, volpath, lightpath, bdpt, sppm, ppm, photonmap, vcm";
 
