@@ -46,7 +46,7 @@ AttributeEnd
     )
 }
 
-const INTEGRATORS: [(&str, &str); 5] = [
+const INTEGRATORS: [(&str, &str); 6] = [
     ("path", r#""path" "integer maxdepth" [5]"#),
     ("lightpath", r#""lightpath" "integer maxdepth" [5]"#),
     ("bdpt", r#""bdpt" "integer maxdepth" [5]"#),
@@ -57,6 +57,10 @@ const INTEGRATORS: [(&str, &str); 5] = [
     (
         "photonmap",
         r#""photonmap" "integer photons" [3000] "integer causticphotons" [3000] "integer gatherrays" [2]"#,
+    ),
+    (
+        "vcm",
+        r#""vcm" "float radius" [0.1] "integer maxdepth" [5]"#,
     ),
 ];
 

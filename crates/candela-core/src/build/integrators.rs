@@ -15,7 +15,7 @@ use crate::integrator::photonmap::Kernel;
 use crate::integrator::{
     BdptIntegrator, BdptSettings, Integrator, IntegratorKind, LightTracer, LightTracerSettings,
     PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator,
-    PpmSettings, SppmIntegrator, SppmSettings, Visualize,
+    PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator, VcmMode, VcmSettings, Visualize,
 };
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription};
 
@@ -27,6 +27,7 @@ enum Settings {
     Sppm(SppmSettings),
     Ppm(PpmSettings),
     PhotonMap(PhotonMapSettings),
+    Vcm(VcmSettings),
 }
 
 /// The integrator a scene asks for (or `--integrator`), read and checked
@@ -56,12 +57,25 @@ pub fn kind_from_name(name: &str) -> Option<(IntegratorKind, bool)> {
         "sppm" => (IntegratorKind::Sppm, false),
         "ppm" => (IntegratorKind::Ppm, false),
         "photonmap" => (IntegratorKind::PhotonMap, false),
+        "vcm" => (IntegratorKind::Vcm, false),
         _ => return None,
     })
 }
 
+/// True for the integrators whose defaults depend on the scene's scale
+/// (the photon integrators and VCM: their radius).
+pub fn needs_scale(kind: IntegratorKind) -> bool {
+    matches!(
+        kind,
+        IntegratorKind::Sppm
+            | IntegratorKind::Ppm
+            | IntegratorKind::PhotonMap
+            | IntegratorKind::Vcm
+    )
+}
+
 /// Names accepted by [`kind_from_name`].
-pub const INTEGRATOR_NAMES: &str = "path, volpath, lightpath, bdpt, sppm, ppm, photonmap";
+pub const INTEGRATOR_NAMES: &str = "path, volpath, lightpath, bdpt, sppm, ppm, photonmap, vcm";
 
 /// Reads and checks the integrator of `desc` (or of `--integrator`).
 pub fn integrator<'a>(
@@ -102,14 +116,19 @@ pub fn integrator<'a>(
     };
     let (settings, strategy_layers) = construct(kind, &ck, &common, power_sampling, warnings)?;
     let radius = match kind {
-        IntegratorKind::Sppm | IntegratorKind::Ppm => ck.float_opt("radius", Domain::Positive)?,
+        IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::Vcm => {
+            ck.float_opt("radius", Domain::Positive)?
+        }
         _ => None,
     };
     // Photons are shot by power, as pbrt-v4's SPPM does.
     let power_sampling = power_sampling
         || matches!(
             kind,
-            IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::PhotonMap
+            IntegratorKind::Sppm
+                | IntegratorKind::Ppm
+                | IntegratorKind::PhotonMap
+                | IntegratorKind::Vcm
         );
     Ok(Planned {
         kind,
@@ -182,6 +201,10 @@ pub fn finish(
             )?;
             Box::new(PpmIntegrator { settings })
         }
+        Settings::Vcm(mut settings) => {
+            settings.radius = radius(warnings);
+            Box::new(VcmIntegrator::new(settings))
+        }
         Settings::PhotonMap(settings) => {
             photon_scale::claim_photon_map(&ck, &settings, budget)?;
             Box::new(PhotonMapIntegrator { settings })
@@ -217,6 +240,7 @@ fn construct(
         }
         IntegratorKind::Sppm => (Settings::Sppm(sppm_settings(ck, common)?), 0),
         IntegratorKind::Ppm => (Settings::Ppm(ppm_settings(ck, common)?), 0),
+        IntegratorKind::Vcm => (Settings::Vcm(vcm_settings(ck, common)?), 0),
         IntegratorKind::PhotonMap => {
             if !power_sampling {
                 warnings.push(format!(
@@ -355,5 +379,26 @@ fn photonmap_settings(ck: &Check<'_>, c: &Common) -> Result<PhotonMapSettings, B
         final_gather: p.get_bool("finalgather", d.final_gather)?,
         gather_rays: count("gatherrays", d.gather_rays as u64, 1)? as u32,
         seed: c.seed,
+    })
+}
+
+/// `Integrator "vcm"` parameters (table in `integrator::vcm`); the radius
+/// is set by [`finish`].
+fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
+    let name = ck.params.get_string("mode", "vcm")?;
+    let Some(mode) = VcmMode::from_name(&name) else {
+        return Err(ck.error(
+            "mode",
+            format!("\"{name}\" is unknown (known: {})", VcmMode::NAMES),
+        ));
+    };
+    Ok(VcmSettings {
+        max_depth: c.max_depth,
+        radius: 1.0,
+        alpha: ck.float("alpha", 0.75, Domain::LeftOpen(0.0, 1.0))?,
+        light_paths: photons_per_iteration(ck)?,
+        seed: photon_seed(ck, c)?,
+        regularize: c.regularize,
+        mode,
     })
 }

@@ -168,7 +168,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         )));
     }
     let integrator = match kind {
-        IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::PhotonMap => {
+        k if integrators::needs_scale(k) => {
             let scale = photon_scale::SceneScale::measure(&scene, &camera, &film);
             integrators::finish(plan, &scale, &mut budget, &mut warnings)?
         }

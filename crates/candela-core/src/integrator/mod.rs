@@ -13,7 +13,9 @@
 //! - `ppm`, `photonmap`: one independent photon pass;
 //! - `sppm`: one iteration, which updates per-pixel statistics carried in
 //!   [`IntegratorState`] (the only integrator whose passes depend on each
-//!   other).
+//!   other);
+//! - `vcm`: one iteration (light subpaths, then camera subpaths), its
+//!   radius fixed by the pass index.
 //!
 //! Camera-driven estimators implement [`PixelEstimator`] and share the
 //! parallel pixel loop of [`driver`].
@@ -29,12 +31,14 @@ pub mod photonmap;
 pub mod roulette;
 pub mod sppm;
 pub mod subpath;
+pub mod vcm;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::{LightTracer, LightTracerSettings};
 pub use path::{PathIntegrator, PathSettings};
 pub use photonmap::{PhotonMapIntegrator, PhotonMapSettings};
 pub use sppm::{PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, SppmState};
+pub use vcm::{VcmIntegrator, VcmMode, VcmSettings};
 
 use crate::camera::Camera;
 use crate::film::{Film, PassBlock, SplatBuffer};
@@ -59,6 +63,8 @@ pub enum IntegratorKind {
     Ppm,
     /// Jensen's two-pass photon mapping.
     PhotonMap,
+    /// Vertex connection and merging.
+    Vcm,
 }
 
 impl IntegratorKind {
@@ -71,6 +77,7 @@ impl IntegratorKind {
             IntegratorKind::Sppm => "sppm",
             IntegratorKind::Ppm => "ppm",
             IntegratorKind::PhotonMap => "photonmap",
+            IntegratorKind::Vcm => "vcm",
         }
     }
 

@@ -1,0 +1,372 @@
+//! VCM's camera pass: one camera subpath per pixel, walked by the one
+//! subpath walker, that at every vertex collects what each enabled technique
+//! gives, MIS-weighted [Georgiev et al. 2012, tech. rep. eqs. 37–45;
+//! SmallVCM `RunIteration`, camera loop]:
+//! - emission of a hit light, or of every infinite light on escape (s = 0,
+//!   eqs. 42–43), in full at the first vertex and after specular chains
+//!   when nothing else connects;
+//! - next-event estimation ([`crate::integrator::nee`], s = 1, eqs. 44–45);
+//! - a connection to each vertex of the light subpath with the pixel's index
+//!   (eqs. 40–41);
+//! - a merge with every light vertex of the iteration within the radius
+//!   (eqs. 38–39), L += β_E Σ f·β_L / (π r² N_light), the light vertex's
+//!   `wo` as the incident direction. As in SPPM, light vertices on surfaces
+//!   facing away (n_L·n_E ≤ 0) are not merged, against leaks through thin
+//!   walls [Jensen 2001, §7.1].
+//!
+//! The pixel's β includes the camera ray's weight; everything found is added
+//! with the film's filter weight to a [`FilmTile`], so the camera side
+//! filters exactly as the path tracer does.
+
+use super::light::{light_densities, LightPaths, LightVertex};
+use super::mis::{weight, Factors, Partial};
+use super::VcmIntegrator;
+use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
+use crate::film::FilmTile;
+use crate::integrator::driver::camera_sample;
+use crate::integrator::nee::{sample_light, Receiver};
+use crate::integrator::roulette::Roulette;
+use crate::integrator::subpath::{
+    walk, Dispersion, Escape, Flow, Scatter, Start, Vertex, Visitor, Walk,
+};
+use crate::integrator::RenderContext;
+use crate::interaction::Interaction;
+use crate::math::{Ray, UVec2};
+use crate::sampler::Sampler;
+use crate::spatial::HashGrid;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// What the camera pass of one iteration shares.
+pub(super) struct CameraPass<'a> {
+    /// The light subpaths.
+    pub light: &'a LightPaths,
+    /// Grid over `light.vertices` (merging modes).
+    pub grid: Option<&'a HashGrid>,
+    /// The merge radius.
+    pub radius: f32,
+    /// MIS constants.
+    pub f: Factors,
+    /// The iteration's wavelengths.
+    pub lambda: SampledWavelengths,
+    /// The iteration's time.
+    pub time: f32,
+    /// The pass index.
+    pub pass: u64,
+}
+
+impl VcmIntegrator {
+    /// Renders the camera subpaths of the pixels in [lo, hi) into a tile.
+    pub(super) fn camera_tile(
+        &self,
+        ctx: &RenderContext<'_>,
+        cp: &CameraPass<'_>,
+        lo: UVec2,
+        hi: UVec2,
+    ) -> FilmTile {
+        let mut tile = ctx.film.tile(lo, hi);
+        let mut sampler = ctx.sampler.clone();
+        let res_x = ctx.film.resolution().x as u64;
+        let n_light = self.light_paths(ctx);
+        for y in lo.y..hi.y {
+            for x in lo.x..hi.x {
+                let pixel = UVec2::new(x, y);
+                sampler.start_pixel_sample(pixel, cp.pass as u32, 0);
+                let Some(cs) = camera_sample(ctx, pixel, &mut sampler) else {
+                    continue;
+                };
+                let index = (y as u64 * res_x + x as u64) % n_light.max(1);
+                let path = cp.light.path(index as usize);
+                let ray = cs.ray.at_time(cp.time);
+                let l = self.camera_path(ctx, cp, ray, cs.ray_weight, path, &mut sampler);
+                tile.add_sample(pixel, l, &cp.lambda, cs.filter_weight);
+            }
+        }
+        tile
+    }
+
+    /// The estimate of one camera subpath starting along `ray`.
+    fn camera_path(
+        &self,
+        ctx: &RenderContext<'_>,
+        cp: &CameraPass<'_>,
+        ray: Ray,
+        ray_weight: f32,
+        path: &[LightVertex],
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
+        let lens = Vertex::camera(
+            Interaction {
+                time: cp.time,
+                ..Interaction::at_point(ray.o)
+            },
+            SampledSpectrum::splat(ray_weight),
+        );
+        let pdf_pixel = self.pixel_density(ctx, &ray);
+        let n_light = self.light_paths(ctx) as f32;
+        let mut v = CameraVisitor {
+            vcm: self,
+            ctx,
+            cp,
+            path,
+            mis: Partial::camera(pdf_pixel, n_light, ctx.camera.is_connectable()),
+            prev: lens,
+            pending: None,
+            specular: true,
+            vertices: 0,
+            l: SampledSpectrum::zero(),
+        };
+        let w = Walk {
+            mode: TransportMode::Radiance,
+            max_depth: self.settings.max_depth + 1,
+            roulette: Some(Roulette::Bidirectional),
+            regularize: self.settings.regularize,
+            dispersion: Dispersion::Fold,
+        };
+        let start = Start {
+            ray,
+            beta: SampledSpectrum::splat(ray_weight),
+            depth: 0,
+            from: Some(lens),
+            pdf_dir: ctx.camera.pdf_we(&ray).1,
+        };
+        let mut lambda = cp.lambda;
+        walk(ctx.scene, &mut lambda, sampler, &w, start, &mut v);
+        v.l
+    }
+}
+
+/// The camera pass's visitor.
+struct CameraVisitor<'a, 'b> {
+    vcm: &'a VcmIntegrator,
+    ctx: &'a RenderContext<'b>,
+    cp: &'a CameraPass<'a>,
+    path: &'a [LightVertex],
+    mis: Partial,
+    prev: Vertex,
+    pending: Option<Scatter>,
+    /// Every scattering so far was a delta.
+    specular: bool,
+    /// Surface vertices visited.
+    vertices: u32,
+    l: SampledSpectrum,
+}
+
+/// Divides a join of two subpaths that both kept only the hero wavelength
+/// by the wavelength count: each side's β carries the fold's factor, the
+/// path only one [module doc of `crate::integrator::subpath`].
+fn unfold(c: SampledSpectrum, cam: bool, light: bool) -> SampledSpectrum {
+    if cam && light {
+        c * (1.0 / c.0.len() as f32)
+    } else {
+        c
+    }
+}
+
+impl Visitor<Sampler> for CameraVisitor<'_, '_> {
+    const DENSITIES: bool = true;
+
+    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut Sampler) -> Flow {
+        if let Some(s) = self.pending.take() {
+            let cos_out = v.wo.dot(self.prev.it.n).abs();
+            self.mis
+                .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
+        }
+        let d2 = (v.p() - self.prev.p()).length_squared();
+        self.mis.hit(d2, v.wo.dot(v.it.n).abs());
+        self.prev = *v;
+        self.vertices += 1;
+        self.emission(v, lambda);
+        let max_depth = self.vcm.settings.max_depth;
+        let Some(bsdf) = &v.bsdf else {
+            return Flow::Continue;
+        };
+        if v.depth > max_depth || !bsdf.flags().is_non_specular() {
+            return Flow::Continue;
+        }
+        let t = self.vcm.techniques;
+        let terminated = lambda.secondary_terminated();
+        if t.connect {
+            self.next_event(v, bsdf, lambda, rng);
+            self.connect(v, bsdf, terminated);
+        }
+        if t.merge {
+            self.merge(v, bsdf, terminated);
+            if t.ppm {
+                return Flow::Stop;
+            }
+        }
+        Flow::Continue
+    }
+
+    fn scattered(&mut self, s: &Scatter) {
+        self.pending = Some(*s);
+        self.specular &= s.delta;
+    }
+
+    fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
+        if let Some(s) = self.pending.take() {
+            let cos_out = e.ray.d.normalize().dot(self.prev.it.n).abs();
+            self.mis
+                .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
+        }
+        let scene = self.ctx.scene;
+        for &id in scene.infinite_lights() {
+            let le = scene.light(id).le(&e.ray, lambda);
+            if le.is_black() {
+                continue;
+            }
+            let w_inf = -e.ray.d.normalize();
+            let it = Interaction::at_point(self.prev.p());
+            let (direct, emission, _) = light_densities(scene, id, &it, w_inf);
+            // Seen straight from the lens: only the camera finds it.
+            let w = if self.vertices == 0 {
+                1.0
+            } else {
+                self.emission_weight(direct, emission)
+            };
+            self.l += e.beta * le * w;
+        }
+    }
+}
+
+impl CameraVisitor<'_, '_> {
+    /// The weight of emission found by the camera subpath [eq. 43].
+    fn emission_weight(&self, direct: f32, emission: f32) -> f32 {
+        if !self.vcm.techniques.connect {
+            return if self.specular { 1.0 } else { 0.0 };
+        }
+        weight(0.0, self.mis.emission_weight(direct, emission))
+    }
+
+    /// s = 0 at a surface vertex that emits.
+    fn emission(&mut self, v: &Vertex, lambda: &SampledWavelengths) {
+        let Some(id) = v.area_light else { return };
+        let scene = self.ctx.scene;
+        let le = scene.light(id).l(v.p(), v.it.n, v.it.uv, v.wo, lambda);
+        if le.is_black() {
+            return;
+        }
+        let (direct, emission, _) = light_densities(scene, id, &v.it, v.wo);
+        let w = if v.depth == 1 {
+            1.0
+        } else {
+            self.emission_weight(direct, emission)
+        };
+        self.l += v.beta * le * w;
+    }
+
+    /// s = 1: a light sample for `v` [eqs. 44–45].
+    fn next_event(
+        &mut self,
+        v: &Vertex,
+        bsdf: &Bsdf,
+        lambda: &SampledWavelengths,
+        rng: &mut Sampler,
+    ) {
+        let scene = self.ctx.scene;
+        let Some(r) = Receiver::at_vertex(v) else {
+            return;
+        };
+        let Some(ls) = sample_light(scene, &r, lambda, rng) else {
+            return;
+        };
+        let light = scene.light(ls.light);
+        let e = ls.vertex(scene);
+        let (direct, emission, cos_light) = light_densities(scene, ls.light, &e.it, -ls.wi);
+        if direct <= 0.0 {
+            return;
+        }
+        let bsdf_dir = if light.is_hittable() {
+            bsdf.pdf(v.wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
+                .0
+        } else {
+            0.0
+        };
+        let bsdf_rev = bsdf
+            .pdf(ls.wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
+            .0;
+        let cos_recv = ls.wi.dot(v.it.n).abs();
+        let inv_d2 = if e.at_infinity() {
+            1.0
+        } else {
+            1.0 / (e.p() - v.p()).length_squared()
+        };
+        let w_light = super::mis::mis(bsdf_dir * cos_light * inv_d2 / direct);
+        let ratio = emission * cos_recv * inv_d2 / direct;
+        let w_cam = self.mis.connect_weight(ratio, bsdf_rev, &self.cp.f);
+        self.l += v.beta * ls.unweighted() * weight(w_light, w_cam);
+    }
+
+    /// Connections to the vertices of the pixel's light subpath [eqs. 40–41].
+    fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
+        let max_depth = self.vcm.settings.max_depth;
+        for lv in self.path {
+            if lv.v.depth + v.depth > max_depth {
+                break;
+            }
+            let Some(lb) = &lv.v.bsdf else { continue };
+            let d = lv.v.p() - v.p();
+            let d2 = d.length_squared();
+            if d2 == 0.0 {
+                continue;
+            }
+            let w = d / d2.sqrt();
+            let f_cam = cb.f(v.wo, w, TransportMode::Radiance) * w.dot(v.ns).abs();
+            let c = v.beta * f_cam * lv.v.f_adjoint_cos(-w) * lv.v.beta / d2;
+            if c.is_black() {
+                continue;
+            }
+            let all = SampleFlags::ALL;
+            let cam_dir = cb.pdf(v.wo, w, TransportMode::Radiance, all).0;
+            let cam_rev = cb.pdf(w, v.wo, TransportMode::Importance, all).0;
+            let light_dir = lb.pdf(lv.v.wo, -w, TransportMode::Importance, all).0;
+            let light_rev = lb.pdf(-w, lv.v.wo, TransportMode::Radiance, all).0;
+            let cam_dir_a = cam_dir * w.dot(lv.v.it.n).abs() / d2;
+            let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
+            let f = &self.cp.f;
+            let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
+            let w_cam = self.mis.connect_weight(light_dir_a, cam_rev, f);
+            let mw = weight(w_light, w_cam);
+            if mw == 0.0 || !self.ctx.scene.unoccluded(&lv.v.it, &v.it) {
+                continue;
+            }
+            self.l += unfold(c * mw, terminated, lv.terminated);
+        }
+    }
+
+    /// Merges with the iteration's light vertices around `v` [eqs. 38–39].
+    fn merge(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
+        let Some(grid) = self.cp.grid else { return };
+        let max_depth = self.vcm.settings.max_depth;
+        let verts = &self.cp.light.vertices;
+        let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
+        let mut sum = SampledSpectrum::zero();
+        grid.for_each_within(v.p(), self.cp.radius, |i, _| {
+            let lv = &verts[i as usize];
+            if lv.v.depth + v.depth > max_depth + 1 || lv.v.it.n.dot(v.it.n) <= 0.0 {
+                return;
+            }
+            let wi = lv.v.wo;
+            let fv = cb.f(v.wo, wi, TransportMode::Radiance);
+            if fv.is_black() {
+                return;
+            }
+            let w = if ppm {
+                1.0
+            } else {
+                let cam_dir = cb
+                    .pdf(v.wo, wi, TransportMode::Radiance, SampleFlags::ALL)
+                    .0;
+                let cam_rev = cb
+                    .pdf(wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
+                    .0;
+                weight(
+                    lv.mis.merge_weight(cam_dir, f),
+                    self.mis.merge_weight(cam_rev, f),
+                )
+            };
+            sum += unfold(fv * lv.v.beta * w, terminated, lv.terminated);
+        });
+        self.l += v.beta * sum * f.merge_norm;
+    }
+}
