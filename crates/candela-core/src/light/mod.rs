@@ -50,7 +50,7 @@ mod spot;
 mod tests;
 
 pub use create::{
-    diffuse_area_image_light, diffuse_area_light, distant_light, goniometric_light,
+    diffuse_area_image_light, diffuse_area_light, distant_light, goniometric_light, ies_light,
     image_infinite_light, point_light, projection_light, spot_light, uniform_infinite_light,
 };
 pub use diffuse_area::DiffuseAreaLight;
