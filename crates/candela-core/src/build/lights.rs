@@ -360,10 +360,8 @@ fn projection(
 
 /// True when `filename` names an IES LM-63 file (extension `.ies`, any case).
 fn is_ies(p: &candela_scene::ParamSet) -> Result<bool, BuildError> {
-    Ok(p.get_filename("filename")?.is_some_and(|f| {
-        f.extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("ies"))
-    }))
+    Ok(p.get_filename("filename")?
+        .is_some_and(|f| f.extension().is_some_and(|e| e.eq_ignore_ascii_case("ies"))))
 }
 
 /// `"goniometric"` from an IES file: `I` (colour), `scale`, `power` or
@@ -381,18 +379,25 @@ fn ies(
     let loc = ck.loc_of("filename");
     if !path.is_file() {
         let name = path.display();
-        return Err(BuildError::at(loc, format!("IES file \"{name}\" not found")));
+        return Err(BuildError::at(
+            loc,
+            format!("IES file \"{name}\" not found"),
+        ));
     }
     let file = candela_scene::ies::read_ies(&path)?;
-    warnings.extend(file.warnings.iter().map(|w| format!("{}: {}", w.loc, w.message)));
+    warnings.extend(
+        file.warnings
+            .iter()
+            .map(|w| format!("{}: {}", w.loc, w.message)),
+    );
     if !matches!(file.tilt, candela_scene::ies::IesTilt::None) {
         return Err(BuildError::at(
             loc,
             format!("{}: TILT other than NONE is not supported", path.display()),
         ));
     }
-    let web = IesWeb::new(&file)
-        .map_err(|e| BuildError::at(loc, format!("{}: {e}", path.display())))?;
+    let web =
+        IesWeb::new(&file).map_err(|e| BuildError::at(loc, format!("{}: {e}", path.display())))?;
     Ok(Light::Goniometric(create::ies_light(
         t,
         i,

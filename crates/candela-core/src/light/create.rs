@@ -53,8 +53,9 @@
 
 use super::projection::screen_window;
 use super::{
-    spectrum_photometric, DiffuseAreaLight, IesWeb, DistantLight, GoniometricLight, ImageInfiniteLight,
-    LightSpectrum, PointLight, ProjectionLight, SpotLight, UniformInfiniteLight,
+    spectrum_photometric, DiffuseAreaLight, DistantLight, GoniometricLight, IesWeb,
+    ImageInfiniteLight, LightSpectrum, PointLight, ProjectionLight, SpotLight,
+    UniformInfiniteLight,
 };
 use crate::image::{MapImage, PixelFormat};
 use crate::math::{Frame, Mat4, Transform, Vec2, Vec3, PI};

@@ -23,7 +23,9 @@
 //! light frame (nadir +z, horizontal angle 0 +x), emission sampling is the
 //! web's own ∝ I(ω), and Φ = scale·I_e·∫I dω with the web's exact flux.
 
-use super::{delta_position_li, IesWeb, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
+use super::{
+    delta_position_li, IesWeb, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum,
+};
 use crate::image::{MapImage, WrapMode};
 use crate::math::{Ray, Transform, Vec2, Vec3, PI};
 use crate::sampling::{

@@ -37,6 +37,7 @@ mod create;
 mod diffuse_area;
 mod distant;
 mod emission;
+mod flux;
 mod goniometric;
 mod ies_web;
 mod image_infinite;
@@ -56,6 +57,7 @@ pub use create::{
 pub use diffuse_area::DiffuseAreaLight;
 pub use distant::DistantLight;
 pub use emission::{spectrum_photometric, LightSpectrum};
+pub use flux::Flux;
 pub use goniometric::GoniometricLight;
 pub use ies_web::{IesSample, IesWeb, IesWebError};
 pub use image_infinite::ImageInfiniteLight;
