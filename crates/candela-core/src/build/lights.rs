@@ -104,17 +104,11 @@ impl AreaLightSpec {
     }
 }
 
-impl AreaLightSpec {
-    /// Records the total area of the shape's triangles, over which a flux
-    /// given in `lumens` is shared.
-    pub fn set_total_area(&mut self, area: f32) {
-        self.total_area = area;
-    }
-}
-
-/// Reads a shape's `AreaLightSource` (pbrt-v4 has only `"diffuse"`).
+/// Reads a shape's `AreaLightSource` (pbrt-v4 has only `"diffuse"`);
+/// `total_area` is the shape's, over which a flux in `lumens` is shared.
 pub fn area_light_spec(
     a: &Entity,
+    total_area: f32,
     warnings: &mut Vec<String>,
 ) -> Result<AreaLightSpec, BuildError> {
     if a.name != "diffuse" {
@@ -162,7 +156,7 @@ pub fn area_light_spec(
         two_sided: p.get_bool("twosided", false)?,
         power: u.target,
         shared: u.from_lumens,
-        total_area: 0.0,
+        total_area,
     })
 }
 
