@@ -16,6 +16,7 @@ pub mod interaction;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod measure;
 pub mod render;
 pub mod sampler;
 pub mod sampling;

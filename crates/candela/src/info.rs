@@ -32,6 +32,19 @@ fn write_summary(f: &mut String, s: &SceneSummary) -> std::fmt::Result {
     writeln!(f, "primitives  {}", counts_line(&s.primitives))?;
     writeln!(f, "triangles   {}", s.triangles)?;
     writeln!(f, "lights      {}", counts_line(&s.lights))?;
+    let (mut watts, mut lumens) = (0.0, 0.0);
+    for (kind, flux) in &s.light_flux {
+        writeln!(
+            f,
+            "  flux      {kind}: {:.6} W, {:.6} lm",
+            flux.watts, flux.lumens
+        )?;
+        watts += flux.watts;
+        lumens += flux.lumens;
+    }
+    if !s.light_flux.is_empty() {
+        writeln!(f, "  flux      total: {watts:.6} W, {lumens:.6} lm")?;
+    }
     writeln!(f, "materials   {}", counts_line(&s.materials))?;
     writeln!(f, "textures    {}", counts_line(&s.textures))?;
     if let Some((lo, hi)) = s.bounds {

@@ -3,6 +3,7 @@
 
 mod info;
 mod live;
+mod measure_cmd;
 mod output;
 mod progress;
 mod render_cmd;
@@ -46,6 +47,9 @@ enum Cmd {
     /// Merge partial renders (`render --pass-range`) of one scene exactly:
     /// the image equals one render of all their passes, bit for bit.
     Merge(render_cmd::MergeArgs),
+    /// Virtual illuminance meter: illuminance [lx] and its standard error at
+    /// each point of `--points` (`x y z nx ny nz` per line), as CSV.
+    Measure(measure_cmd::MeasureArgs),
 }
 
 /// Parses "x0,y0,x1,y1".
@@ -68,6 +72,7 @@ fn main() {
         Cmd::Info { scene } => info(&scene, &Overrides::default()),
         Cmd::Diff { a, b, region } => diff(&a, &b, region).map(|()| 0),
         Cmd::Merge(args) => render_cmd::merge(args).map(|()| 0),
+        Cmd::Measure(args) => measure_cmd::measure(args).map(|()| 0),
     };
     match result {
         Ok(0) => {}

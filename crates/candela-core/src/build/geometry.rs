@@ -168,11 +168,12 @@ fn add_shape(
     }
     let shapes = build_shape(s, &render_from_object, sink.budget)?;
     finite_bounds(s, shapes.iter().map(Shape::bounds))?;
+    let area = shapes.iter().map(Shape::area).sum();
     let spec = s
         .area_light
         .as_ref()
-        .map(|a| area_light_spec(a, warnings))
-        .transpose()?;
+        .map(|a| area_light_spec(a, area, warnings));
+    let spec = spec.transpose()?;
     let alpha = match alpha {
         // pbrt-v4's invisible light: an emitter with constant alpha 0 is
         // never hit (no primitive), yet still lights the scene.

@@ -23,16 +23,25 @@
 //! may hold infinite or NaN texels. A projector's `fov` must lie in
 //! (0°, 180°).
 //!
+//! `"goniometric"` with a `filename` ending in `.ies` reads an IES LM-63
+//! file instead (`candela_scene::ies`, `light::IesWeb`): photometric nadir
+//! along `to − from` (default +z), horizontal angle 0 along light-space +x;
+//! `I` then only sets the colour. `TILT` other than `NONE` is refused.
+//!
+//! Photometric units (`candela`, `luminance`, `lumens`, `lux`) are read by
+//! [`super::photometric`] for every light.
+//!
 //! Every light's `scale` is ≥ 0 (a negative one would emit negative
 //! radiance); a spot light's `coneangle` lies in (0°, 180°] and its
 //! `conedeltaangle` in [0°, `coneangle`]. A `power` or `illuminance` ≤ 0
 //! means "not given", as in pbrt-v4.
 
 use super::check::{Check, Domain};
+use super::photometric::{units, Units, UnitsOf};
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
 use crate::image::{read_map, ColorEncoding, MapImage};
-use crate::light::{self as create, Light};
+use crate::light::{self as create, IesWeb, Light};
 use crate::math::{Transform, Vec3};
 use crate::shape::Shape;
 use crate::spectrum::{ColorSpace, Spectrum};
@@ -44,10 +53,6 @@ use std::sync::Arc;
 fn cs(name: &str, loc: &Loc) -> Result<&'static ColorSpace, BuildError> {
     ColorSpace::by_name(name)
         .ok_or_else(|| BuildError::at(loc, format!("unknown color space \"{name}\"")))
-}
-
-fn optional_positive(v: f32) -> Option<f32> {
-    (v > 0.0).then_some(v)
 }
 
 /// What a diffuse area light emits: a spectrum, or an RGB image and its
@@ -65,15 +70,25 @@ pub struct AreaLightSpec {
     scale: f32,
     two_sided: bool,
     power: Option<f32>,
+    /// `power` came from `lumens`: it is the whole shape's, shared by area.
+    shared: bool,
+    /// Total area of the shape's triangles (for `shared`).
+    total_area: f32,
 }
 
 impl AreaLightSpec {
     /// The light on `shape` (render space), its emission cut by `alpha`.
     pub fn light(&self, shape: &Shape, alpha: Option<FloatTexture>) -> Light {
+        let power = match self.power {
+            Some(p) if self.shared && self.total_area > 0.0 => {
+                Some(p * shape.area() / self.total_area)
+            }
+            p => p,
+        };
         let (shape, scale, two) = (shape.clone(), self.scale, self.two_sided);
         let light = match &self.emission {
             AreaEmission::Spectrum(l) => {
-                create::diffuse_area_light(shape, l.clone(), scale, two, self.power)
+                create::diffuse_area_light(shape, l.clone(), scale, two, power)
             }
             AreaEmission::Image(im, cs) => create::diffuse_area_image_light(
                 shape,
@@ -82,16 +97,18 @@ impl AreaLightSpec {
                 self.scene_cs,
                 scale,
                 two,
-                self.power,
+                power,
             ),
         };
         Light::DiffuseArea(light.with_alpha(alpha))
     }
 }
 
-/// Reads a shape's `AreaLightSource` (pbrt-v4 has only `"diffuse"`).
+/// Reads a shape's `AreaLightSource` (pbrt-v4 has only `"diffuse"`);
+/// `total_area` is the shape's, over which a flux in `lumens` is shared.
 pub fn area_light_spec(
     a: &Entity,
+    total_area: f32,
     warnings: &mut Vec<String>,
 ) -> Result<AreaLightSpec, BuildError> {
     if a.name != "diffuse" {
@@ -131,12 +148,15 @@ pub fn area_light_spec(
     };
     let what = format!("AreaLightSource \"{}\"", a.name);
     let ck = Check::new(p, &a.loc, &what);
+    let u = units(&ck, UnitsOf::Area)?;
     Ok(AreaLightSpec {
         emission,
         scene_cs,
-        scale: ck.float("scale", 1.0, Domain::NonNegative)?,
+        scale: u.scale,
         two_sided: p.get_bool("twosided", false)?,
-        power: optional_positive(p.get_float("power", -1.0)?),
+        power: u.target,
+        shared: u.from_lumens,
+        total_area,
     })
 }
 
@@ -159,44 +179,37 @@ fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError>
     };
     let what = format!("LightSource \"{}\"", d.name);
     let ck = Check::new(p, &d.loc, &what);
-    let scale = ck.float("scale", 1.0, Domain::NonNegative)?;
     let v3 = |name: &str, def: Vec3| -> Result<Vec3, BuildError> {
         Ok(p.get_point3(name, def.to_array())?.into())
     };
-    if matches!(d.name.as_str(), "spot" | "distant")
-        && v3("from", Vec3::ZERO)? == v3("to", Vec3::Z)?
-    {
+    let (from, to) = (v3("from", Vec3::ZERO)?, v3("to", Vec3::Z)?);
+    if matches!(d.name.as_str(), "spot" | "distant" | "goniometric") && from == to {
         return Err(ck.error(
             "to",
             "must differ from \"from\": together they give the light's direction",
         ));
     }
+    let u = |of| units(&ck, of);
     Ok(match d.name.as_str() {
-        "point" => Light::Point(create::point_light(&t, illum("I")?, scale, optional_positive(p.get_float("power", -1.0)?), v3("from", Vec3::ZERO)?)),
-        "spot" => Light::Spot(create::spot_light(
-            &t,
-            illum("I")?,
-            scale,
-            ck.float("coneangle", 30.0, Domain::LeftOpen(0.0, 180.0))?,
-            {
-                let cone = p.get_float("coneangle", 30.0)?;
-                ck.float("conedeltaangle", 5.0, Domain::Closed(0.0, cone))?
-            },
-            optional_positive(p.get_float("power", -1.0)?),
-            v3("from", Vec3::ZERO)?,
-            v3("to", Vec3::Z)?,
-        )),
-        "distant" => Light::Distant(create::distant_light(
-            &t,
-            illum("L")?,
-            scale,
-            optional_positive(p.get_float("illuminance", -1.0)?),
-            v3("from", Vec3::ZERO)?,
-            v3("to", Vec3::Z)?,
-        )),
-        "infinite" => infinite(d, &t, space, scale, warnings)?,
-        "goniometric" => goniometric(d, &t, illum("I")?, scale, warnings)?,
-        "projection" => projection(d, &t, scale, warnings)?,
+        "point" => {
+            let u = u(UnitsOf::Intensity)?;
+            Light::Point(create::point_light(&t, illum("I")?, u.scale, u.target, from))
+        }
+        "spot" => {
+            let u = u(UnitsOf::Intensity)?;
+            let cone = ck.float("coneangle", 30.0, Domain::LeftOpen(0.0, 180.0))?;
+            let delta = ck.float("conedeltaangle", 5.0, Domain::Closed(0.0, cone))?;
+            let i = illum("I")?;
+            Light::Spot(create::spot_light(&t, i, u.scale, cone, delta, u.target, from, to))
+        }
+        "distant" => {
+            let u = u(UnitsOf::Distant)?;
+            Light::Distant(create::distant_light(&t, illum("L")?, u.scale, u.target, from, to))
+        }
+        "infinite" => infinite(d, &ck, &t, space, warnings)?,
+        "goniometric" if is_ies(p)? => ies(d, &ck, &t, illum("I")?, (from, to), warnings)?,
+        "goniometric" => goniometric(d, &t, illum("I")?, u(UnitsOf::Intensity)?, warnings)?,
+        "projection" => projection(d, &t, u(UnitsOf::Intensity)?, warnings)?,
         other => return Err(BuildError::at(&d.loc, format!("light \"{other}\" is not supported (supported: point, spot, goniometric, projection, distant, infinite)"))),
     })
 }
@@ -204,15 +217,23 @@ fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError>
 /// pbrt-v4 `"infinite"`: uniform (`L` or the illuminant) or image (`filename`).
 fn infinite(
     d: &LightDesc,
+    ck: &Check<'_>,
     t: &Transform,
     space: &'static ColorSpace,
-    scale: f32,
     warnings: &mut Vec<String>,
 ) -> Result<Light, BuildError> {
     let p = &d.params;
     let l = spectrum_param(p, "L", SpectrumKind::Illuminant, space)?;
     let file = p.get_filename("filename")?;
-    let illuminance = optional_positive(p.get_float("illuminance", -1.0)?);
+    let of = match file {
+        Some(_) => UnitsOf::ImageSky,
+        None => UnitsOf::UniformSky,
+    };
+    let Units {
+        scale,
+        target: illuminance,
+        ..
+    } = units(ck, of)?;
     if p.get_point3s("portal")?.is_some() {
         warnings.push(format!(
             "{}: \"portal\" ignored: candela samples the environment over the whole sphere and shows it in every direction (the same image where the portal is the only opening)",
@@ -249,11 +270,11 @@ fn goniometric(
     d: &LightDesc,
     t: &Transform,
     i: Spectrum,
-    scale: f32,
+    u: Units,
     warnings: &mut Vec<String>,
 ) -> Result<Light, BuildError> {
     let p = &d.params;
-    let power = optional_positive(p.get_float("power", -1.0)?);
+    let (scale, power) = (u.scale, u.target);
     let image = match p.get_filename("filename")? {
         Some(path) => {
             let loc = p.param_loc("filename").unwrap_or(&d.loc);
@@ -292,11 +313,11 @@ fn goniometric(
 fn projection(
     d: &LightDesc,
     t: &Transform,
-    scale: f32,
+    u: Units,
     warnings: &mut Vec<String>,
 ) -> Result<Light, BuildError> {
     let p = &d.params;
-    let power = optional_positive(p.get_float("power", -1.0)?);
+    let (scale, power) = (u.scale, u.target);
     let fov = p.get_float("fov", 90.0)?;
     if !(fov > 0.0 && fov < 180.0) {
         return Err(BuildError::at(
@@ -328,6 +349,57 @@ fn projection(
         scale,
         power,
         fov,
+    )))
+}
+
+/// True when `filename` names an IES LM-63 file (extension `.ies`, any case).
+fn is_ies(p: &candela_scene::ParamSet) -> Result<bool, BuildError> {
+    Ok(p.get_filename("filename")?
+        .is_some_and(|f| f.extension().is_some_and(|e| e.eq_ignore_ascii_case("ies"))))
+}
+
+/// `"goniometric"` from an IES file: `I` (colour), `scale`, `power` or
+/// `lumens`, `from`/`to` (the photometric nadir).
+fn ies(
+    d: &LightDesc,
+    ck: &Check<'_>,
+    t: &Transform,
+    i: Spectrum,
+    (from, to): (Vec3, Vec3),
+    warnings: &mut Vec<String>,
+) -> Result<Light, BuildError> {
+    let u = units(ck, UnitsOf::IesWeb)?;
+    let path = d.params.get_filename("filename")?.unwrap_or_default();
+    let loc = ck.loc_of("filename");
+    if !path.is_file() {
+        let name = path.display();
+        return Err(BuildError::at(
+            loc,
+            format!("IES file \"{name}\" not found"),
+        ));
+    }
+    let file = candela_scene::ies::read_ies(&path)?;
+    warnings.extend(
+        file.warnings
+            .iter()
+            .map(|w| format!("{}: {}", w.loc, w.message)),
+    );
+    if !matches!(file.tilt, candela_scene::ies::IesTilt::None) {
+        return Err(BuildError::at(
+            loc,
+            format!("{}: TILT other than NONE is not supported", path.display()),
+        ));
+    }
+    let web =
+        IesWeb::new(&file).map_err(|e| BuildError::at(loc, format!("{}: {e}", path.display())))?;
+    Ok(Light::Goniometric(create::ies_light(
+        t,
+        i,
+        u.scale,
+        u.target,
+        Arc::new(web),
+        from,
+        to,
     )))
 }
 

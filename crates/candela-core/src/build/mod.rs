@@ -17,6 +17,7 @@ mod image_textures;
 mod integrators;
 mod lights;
 mod materials;
+mod photometric;
 mod photon_scale;
 mod shapes;
 mod spectra;

@@ -8,7 +8,7 @@
 //! shape and as its triangles, and an emitting mesh as one light per face.
 
 use super::RenderSetup;
-use crate::light::Light;
+use crate::light::{Flux, Light};
 use crate::shape::Shape;
 use candela_scene::{ParamSet, SceneDescription};
 use std::collections::BTreeMap;
@@ -37,6 +37,8 @@ pub struct SceneSummary {
     pub triangles: usize,
     /// Built lights by type (one area light per emitting primitive).
     pub lights: Counts,
+    /// Total flux of the lights of each type, in type order.
+    pub light_flux: BTreeMap<String, Flux>,
     /// `Material` and `MakeNamedMaterial` directives by (pbrt-v4) type.
     pub materials: Counts,
     /// `Texture` directives by kind and class.
@@ -82,6 +84,16 @@ fn shape_kind(s: &Shape) -> &'static str {
     }
 }
 
+/// Total flux of the lights of each kind.
+fn flux_by_kind(lights: &[Light]) -> BTreeMap<String, Flux> {
+    let mut m = BTreeMap::<String, Flux>::new();
+    for l in lights {
+        *m.entry(light_kind(l).to_string()).or_default() += l.flux();
+    }
+    m
+}
+
+/// The name `candela info` gives a light's kind.
 fn light_kind(l: &Light) -> &'static str {
     match l {
         Light::Point(_) => "point",
@@ -152,6 +164,7 @@ pub fn summarize(desc: &SceneDescription, setup: &RenderSetup) -> SceneSummary {
         primitives: count(prims.iter().map(|p| shape_kind(&p.shape))),
         triangles,
         lights: count(setup.scene.lights().iter().map(light_kind)),
+        light_flux: flux_by_kind(setup.scene.lights()),
         materials: count(
             desc.materials
                 .iter()

@@ -53,14 +53,15 @@
 
 use super::projection::screen_window;
 use super::{
-    spectrum_photometric, DiffuseAreaLight, DistantLight, GoniometricLight, ImageInfiniteLight,
-    LightSpectrum, PointLight, ProjectionLight, SpotLight, UniformInfiniteLight,
+    spectrum_photometric, DiffuseAreaLight, DistantLight, GoniometricLight, IesWeb,
+    ImageInfiniteLight, LightSpectrum, PointLight, ProjectionLight, SpotLight,
+    UniformInfiniteLight,
 };
 use crate::image::{MapImage, PixelFormat};
 use crate::math::{Frame, Mat4, Transform, Vec2, Vec3, PI};
 use crate::sampling::equal_area_square_to_sphere;
 use crate::shape::Shape;
-use crate::spectrum::ColorSpace;
+use crate::spectrum::{ColorSpace, K_M};
 use std::sync::Arc;
 
 /// `scale / SpectrumToPhotometric(s)`: normalises `s` to one nit [pbrt-v4].
@@ -287,6 +288,38 @@ pub fn goniometric_light(
     let swap_yz = Mat4::from_cols(glam::Vec4::X, glam::Vec4::Z, glam::Vec4::Y, glam::Vec4::W);
     let t = render_from_light.then_after(&Transform::new(swap_yz, swap_yz));
     GoniometricLight::new(t, i, sc, Arc::new(y_map))
+}
+
+/// `"goniometric"` with an IES LM-63 `web` [cd]: photometric nadir along
+/// `to − from`, horizontal angle 0 along light-space +x projected
+/// perpendicular to it (+y when `to − from` is along ±x). The web is
+/// absolute, so `scale·I` only sets the colour: I_v(ω) = scale·I_web(ω)
+/// (the spectrum normalised to one nit, then ÷ K_M). With `power` (pbrt-v4
+/// units, lumens/K_M) the web is rescaled to that flux instead.
+pub fn ies_light(
+    render_from_light: &Transform,
+    i: LightSpectrum,
+    scale: f32,
+    power: Option<f32>,
+    web: Arc<IesWeb>,
+    from: Vec3,
+    to: Vec3,
+) -> GoniometricLight {
+    let mut sc = nit_scale(scale, &i);
+    match given(power) {
+        Some(phi_v) if web.flux() > 0.0 => sc *= phi_v / web.flux() as f32,
+        _ => sc /= K_M,
+    }
+    let z = (to - from).normalize();
+    let x_hint = if z.cross(Vec3::X).length() > 1e-3 {
+        Vec3::X
+    } else {
+        Vec3::Y
+    };
+    let t = render_from_light
+        .then_after(&Transform::translate(from))
+        .then_after(&frame_to_render(&Frame::from_xz(x_hint, z)));
+    GoniometricLight::from_web(t, i, sc, web)
 }
 
 /// pbrt-v4 `"projection"`: RGB `image` in colour space `cs` projected with

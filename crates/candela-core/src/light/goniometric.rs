@@ -17,8 +17,15 @@
 //! equal-area, so p_dir = p/(4π) without a Jacobian [pbrt-v4 `SampleLe`].
 //! Then p_dir(ω) = Y(ω)/(4π·mean Y) is proportional to I(ω) and
 //! `β₀ = I/p_dir = Φ` for every sample.
+//!
+//! **IES webs.** The same light may instead carry an [`IesWeb`] (an IES
+//! LM-63 file): `Y(ω)` is then the web's bilinear intensity [cd] in the
+//! light frame (nadir +z, horizontal angle 0 +x), emission sampling is the
+//! web's own ∝ I(ω), and Φ = scale·I_e·∫I dω with the web's exact flux.
 
-use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
+use super::{
+    delta_position_li, IesWeb, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum,
+};
 use crate::image::{MapImage, WrapMode};
 use crate::math::{Ray, Transform, Vec2, Vec3, PI};
 use crate::sampling::{
@@ -35,9 +42,20 @@ pub struct GoniometricLight {
     light_from_render: Transform,
     i: LightSpectrum,
     scale: f32,
-    image: Arc<MapImage>,
-    distribution: Arc<Distribution2D>,
-    mean_y: f32,
+    pattern: Pattern,
+}
+
+/// The directional factor Y(ω) of a goniometric light.
+#[derive(Clone, Debug)]
+enum Pattern {
+    /// pbrt-v4's equal-area image, its texel distribution and mean.
+    Map {
+        image: Arc<MapImage>,
+        distribution: Arc<Distribution2D>,
+        mean_y: f32,
+    },
+    /// An IES photometric web [cd].
+    Web(Arc<IesWeb>),
 }
 
 impl GoniometricLight {
@@ -61,9 +79,46 @@ impl GoniometricLight {
             render_from_light,
             i,
             scale,
-            image,
-            distribution,
-            mean_y,
+            pattern: Pattern::Map {
+                image,
+                distribution,
+                mean_y,
+            },
+        }
+    }
+
+    /// Light of intensity `scale·i·I_web(ω)` with `web` in the light frame.
+    pub fn from_web(
+        render_from_light: Transform,
+        i: LightSpectrum,
+        scale: f32,
+        web: Arc<IesWeb>,
+    ) -> Self {
+        Self {
+            light_from_render: render_from_light.inverse(),
+            render_from_light,
+            i,
+            scale,
+            pattern: Pattern::Web(web),
+        }
+    }
+
+    /// Y(ω) towards light-frame unit direction `wl`.
+    fn pattern(&self, wl: Vec3) -> f32 {
+        match &self.pattern {
+            Pattern::Map { image, .. } => {
+                let uv = equal_area_sphere_to_square(wl);
+                image.nearest_rgb(uv, WrapMode::Clamp)[0]
+            }
+            Pattern::Web(web) => web.intensity(wl),
+        }
+    }
+
+    /// ∫ Y dω over the sphere.
+    fn pattern_integral(&self) -> f32 {
+        match &self.pattern {
+            Pattern::Map { mean_y, .. } => 4.0 * PI * mean_y,
+            Pattern::Web(web) => web.flux() as f32,
         }
     }
 
@@ -74,9 +129,7 @@ impl GoniometricLight {
 
     /// Intensity towards light-frame unit direction `wl` [W/sr].
     pub fn intensity(&self, wl: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
-        let uv = equal_area_sphere_to_square(wl);
-        let y = self.image.nearest_rgb(uv, WrapMode::Clamp)[0];
-        self.i.sample(lambda) * (self.scale * y)
+        self.i.sample(lambda) * (self.scale * self.pattern(wl))
     }
 
     /// Incident radiance I(ω)/d² towards the light; density 1 (delta).
@@ -91,37 +144,51 @@ impl GoniometricLight {
         })
     }
 
-    /// A direction drawn from the texel distribution (`u1`).
+    /// A direction drawn ∝ Y(ω) (`u1`): the texel distribution or the web's.
     pub fn sample_le(
         &self,
         u1: Vec2,
         _u2: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLeSample> {
-        let (uv, map_pdf) = self.distribution.sample(u1);
-        if map_pdf == 0.0 {
+        let (wl, pdf) = match &self.pattern {
+            Pattern::Map { distribution, .. } => {
+                let (uv, map_pdf) = distribution.sample(u1);
+                (equal_area_square_to_sphere(uv), map_pdf / (4.0 * PI))
+            }
+            Pattern::Web(web) => {
+                let s = web.sample(u1)?;
+                (s.w, s.pdf.0)
+            }
+        };
+        if pdf == 0.0 {
             return None;
         }
-        let wl = equal_area_square_to_sphere(uv);
         let d = self.render_from_light.vector(wl).normalize();
         Some(LightLeSample {
             l: self.intensity(wl, lambda),
             ray: Ray::new(self.position(), d),
             intr: None,
             pdf_pos: PdfArea(1.0),
-            pdf_dir: PdfSolidAngle(map_pdf / (4.0 * PI)),
+            pdf_dir: PdfSolidAngle(pdf),
         })
     }
 
-    /// Densities of [`sample_le`](Self::sample_le) for `ray`: (1 (delta), p(u, v)/(4π)).
+    /// Densities of [`sample_le`](Self::sample_le) for `ray`: (1 (delta),
+    /// p(u, v)/(4π) or the web's density).
     pub fn pdf_le(&self, ray: &Ray) -> (PdfArea, PdfSolidAngle) {
         let wl = self.light_from_render.vector(ray.d).normalize();
-        let map_pdf = self.distribution.pdf(equal_area_sphere_to_square(wl));
-        (PdfArea(1.0), PdfSolidAngle(map_pdf / (4.0 * PI)))
+        let pdf = match &self.pattern {
+            Pattern::Map { distribution, .. } => {
+                distribution.pdf(equal_area_sphere_to_square(wl)) / (4.0 * PI)
+            }
+            Pattern::Web(web) => web.pdf(wl).0,
+        };
+        (PdfArea(1.0), PdfSolidAngle(pdf))
     }
 
-    /// Φ = 4π·scale·I_e·mean(Y).
+    /// Φ = scale·I_e·∫Y dω (4π·mean(Y) for a map, the web's flux for IES).
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
-        self.i.sample(lambda) * (4.0 * PI * self.scale * self.mean_y)
+        self.i.sample(lambda) * (self.scale * self.pattern_integral())
     }
 }

@@ -37,6 +37,7 @@ mod create;
 mod diffuse_area;
 mod distant;
 mod emission;
+mod flux;
 mod goniometric;
 mod ies_web;
 mod image_infinite;
@@ -50,12 +51,13 @@ mod spot;
 mod tests;
 
 pub use create::{
-    diffuse_area_image_light, diffuse_area_light, distant_light, goniometric_light,
+    diffuse_area_image_light, diffuse_area_light, distant_light, goniometric_light, ies_light,
     image_infinite_light, point_light, projection_light, spot_light, uniform_infinite_light,
 };
 pub use diffuse_area::DiffuseAreaLight;
 pub use distant::DistantLight;
 pub use emission::{spectrum_photometric, LightSpectrum};
+pub use flux::Flux;
 pub use goniometric::GoniometricLight;
 pub use ies_web::{IesSample, IesWeb, IesWebError};
 pub use image_infinite::ImageInfiniteLight;

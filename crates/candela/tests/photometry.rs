@@ -1,0 +1,161 @@
+//! Photometric units end to end through the CLI: `candela measure` against
+//! closed forms (inverse-square law, E = πL under a uniform sky, an IES
+//! file's intensity) and `candela info` reading back a flux given in lumens.
+//!
+//! Tolerances: each measured point must lie within 5σ of the closed form,
+//! σ its own reported standard error (i.i.d. samples, fixed seed); the few
+//! points per scene make the family-wise false-alarm rate < 10⁻⁵.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// A fresh temporary directory for one test.
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("candela-photometry-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `candela measure` and returns (E, stderr) per point.
+fn measure(d: &PathBuf, scene: &str, points: &str) -> Vec<(f64, f64)> {
+    std::fs::write(d.join("s.pbrt"), scene).unwrap();
+    std::fs::write(d.join("p.txt"), points).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
+        .args([
+            "measure",
+            "s.pbrt",
+            "--points",
+            "p.txt",
+            "--samples",
+            "4000",
+            "--seed",
+            "7",
+        ])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("x,y,z,nx,ny,nz,illuminance_lx,stderr_lx")
+    );
+    lines
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[6], v[7])
+        })
+        .collect()
+}
+
+/// Asserts `got` is within 5σ of `want` (and that σ is sane).
+fn within_5_sigma((got, se): (f64, f64), want: f64) {
+    assert!(se < 0.01 * want, "stderr {se} too large for {want}");
+    assert!(
+        (got - want).abs() <= 5.0 * se.max(1e-9 * want),
+        "E = {got} ± {se}, expected {want}"
+    );
+}
+
+const POINTS: &str = "0 0 0 0 0 1\n# off axis\n1 0 0 0 0 1\n0 1.5 0 0 0 1\n";
+
+/// I·cos θ/r² at the three POINTS for a source at (0, 0, 2).
+fn inverse_square(i: f64) -> Vec<f64> {
+    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.5)]
+        .iter()
+        .map(|&(x, y): &(f64, f64)| {
+            let r2 = x * x + y * y + 4.0;
+            i * (2.0 / r2.sqrt()) / r2
+        })
+        .collect()
+}
+
+#[test]
+fn point_light_in_lumens_follows_the_inverse_square_law_for_any_spectrum() {
+    let d = dir("point");
+    // T8: 1000 lm isotropic → 79.577 cd → 19.894 lx 2 m below, any spectrum.
+    for spectrum in [
+        "\"blackbody I\" 2856",
+        "\"spectrum I\" \"stdillum-D65\"",
+        "",
+    ] {
+        let scene = format!(
+            "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+             LightSource \"point\" \"float lumens\" 1000 {spectrum} \"point3 from\" [0 0 2]\n"
+        );
+        let got = measure(&d, &scene, POINTS);
+        let want = inverse_square(1000.0 / (4.0 * std::f64::consts::PI));
+        assert!((want[0] - 19.894).abs() < 1e-3);
+        for (g, w) in got.into_iter().zip(want) {
+            within_5_sigma(g, w);
+        }
+    }
+}
+
+#[test]
+fn ies_goniometric_light_gives_its_tabulated_candela() {
+    let d = dir("ies");
+    // I(V) = 100 + 50·V/90 cd for V ≤ 90°, linear between the tabulated
+    // angles, so the bilinear web reproduces it exactly; nadir along −z.
+    std::fs::write(
+        d.join("t.ies"),
+        "IESNA:LM-63-2002\n[TEST] linear\nTILT=NONE\n1 -1 1 3 1 1 1 0 0 0\n1 1 0\n0 90 180\n0\n100 150 0\n",
+    )
+    .unwrap();
+    let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+                 LightSource \"goniometric\" \"string filename\" \"t.ies\" \"point3 from\" [0 0 2] \"point3 to\" [0 0 0]\n";
+    let got = measure(&d, scene, POINTS);
+    for ((x, y), g) in [(0.0f64, 0.0f64), (1.0, 0.0), (0.0, 1.5)]
+        .into_iter()
+        .zip(got)
+    {
+        let r2 = x * x + y * y + 4.0;
+        let v = (x.hypot(y) / 2.0).atan().to_degrees();
+        let i = 100.0 + 50.0 * v / 90.0;
+        within_5_sigma(g, i * (2.0 / r2.sqrt()) / r2);
+    }
+}
+
+#[test]
+fn uniform_sky_in_luminance_gives_pi_l() {
+    let d = dir("sky");
+    let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+                 LightSource \"infinite\" \"float luminance\" 100\n";
+    for g in measure(&d, scene, POINTS) {
+        within_5_sigma(g, std::f64::consts::PI * 100.0);
+    }
+}
+
+#[test]
+fn info_reads_back_a_flux_given_in_lumens() {
+    let d = dir("info");
+    let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+                 AttributeBegin\nAreaLightSource \"diffuse\" \"float lumens\" 500 \"blackbody L\" 4000\n\
+                 Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 3 0 0 1 0] \"integer indices\" [0 1 2 0 2 3]\n\
+                 AttributeEnd\n";
+    std::fs::write(d.join("s.pbrt"), scene).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
+        .args(["info", "s.pbrt"])
+        .current_dir(&d)
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.contains("flux      total"))
+        .unwrap();
+    let lm: f64 = line
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .trim()
+        .trim_end_matches(" lm")
+        .parse()
+        .unwrap();
+    assert!((lm - 500.0).abs() < 0.05, "{line}");
+}
