@@ -29,6 +29,7 @@ pub mod photonmap;
 pub mod roulette;
 pub mod sppm;
 pub mod subpath;
+pub mod wavelengths;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::{LightTracer, LightTracerSettings};
