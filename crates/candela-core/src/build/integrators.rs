@@ -12,6 +12,7 @@ use super::check::{Check, Domain};
 use super::photon_scale::{self, SceneScale};
 use super::{BuildError, Overrides};
 use crate::integrator::photonmap::Kernel;
+use crate::integrator::wavelengths::{DEFAULT_GROUPS, MAX_GROUPS};
 use crate::integrator::{
     BdptIntegrator, BdptSettings, Integrator, IntegratorKind, LightTracer, LightTracerSettings,
     PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator,
@@ -330,6 +331,17 @@ fn photons_per_iteration(ck: &Check<'_>) -> Result<i64, BuildError> {
     Ok(ck.params.get_int("photonsperiteration", -1)? as i64)
 }
 
+/// `"integer wavelengthgroups"`: wavelength groups per photon pass, 1 to
+/// [`MAX_GROUPS`] (see `integrator::wavelengths`).
+fn wavelength_groups(ck: &Check<'_>) -> Result<u32, BuildError> {
+    Ok(ck.int_in(
+        "wavelengthgroups",
+        DEFAULT_GROUPS as i32,
+        1,
+        MAX_GROUPS as i32,
+    )? as u32)
+}
+
 /// SPPM's settings; the radius is set by [`finish`].
 fn sppm_settings(ck: &Check<'_>, c: &Common) -> Result<SppmSettings, BuildError> {
     Ok(SppmSettings {
@@ -337,6 +349,7 @@ fn sppm_settings(ck: &Check<'_>, c: &Common) -> Result<SppmSettings, BuildError>
         radius: 1.0,
         max_depth: c.max_depth,
         seed: photon_seed(ck, c)?,
+        wavelength_groups: wavelength_groups(ck)?,
     })
 }
 
@@ -347,6 +360,7 @@ fn ppm_settings(ck: &Check<'_>, c: &Common) -> Result<PpmSettings, BuildError> {
         radius: 1.0,
         max_depth: c.max_depth,
         seed: photon_seed(ck, c)?,
+        wavelength_groups: wavelength_groups(ck)?,
     })
 }
 
@@ -379,6 +393,7 @@ fn photonmap_settings(ck: &Check<'_>, c: &Common) -> Result<PhotonMapSettings, B
         final_gather: p.get_bool("finalgather", d.final_gather)?,
         gather_rays: count("gatherrays", d.gather_rays as u64, 1)? as u32,
         seed: c.seed,
+        wavelength_groups: wavelength_groups(ck)?,
     })
 }
 

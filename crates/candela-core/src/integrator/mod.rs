@@ -32,6 +32,7 @@ pub mod roulette;
 pub mod sppm;
 pub mod subpath;
 pub mod vcm;
+pub mod wavelengths;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::{LightTracer, LightTracerSettings};

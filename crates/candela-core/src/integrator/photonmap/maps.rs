@@ -1,8 +1,10 @@
 //! The two photon maps of one pass and the radiance estimate.
 //!
-//! **Contents.** Photons are shot with [`trace_photon`]; a hit of photon
-//! path `i` at its `d`-th surface is stored with power ΔΦ = β/N, N the
-//! number of paths shot for that map [Jensen 2001, §5.1, eq. 5.1 for one
+//! **Contents.** Photons are shot with [`trace_photon`]; each wavelength
+//! group of the pass ([`crate::integrator::wavelengths`]) has its own pair
+//! of maps, holding the hits of the paths `i` with `i mod G` = g. A hit of
+//! photon path `i` at its `d`-th surface is stored with power ΔΦ = β/N_g,
+//! N_g the number of paths of its group shot for that map [Jensen 2001, §5.1, eq. 5.1 for one
 //! light and a power-proportional choice among several]. The caustic map
 //! keeps the L S+ D hits of `causticphotons` paths. What the global map
 //! keeps depends on how it is read (see the module doc of `photonmap`):
@@ -52,11 +54,12 @@
 use super::PhotonMapSettings;
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
+use crate::integrator::wavelengths::PassWavelengths;
 use crate::math::Vec3;
 use crate::sampling::hash_u64s;
 use crate::scene::Scene;
 use crate::spatial::{HasPosition, Neighbor, PointKdTree};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::SampledSpectrum;
 use rayon::prelude::*;
 
 /// Photon paths per parallel work item (results are concatenated in order).
@@ -256,13 +259,14 @@ pub struct PassMaps {
 }
 
 impl PassMaps {
-    /// Shoots and builds both maps of `pass` at the pass wavelengths.
+    /// Shoots and builds both maps of every wavelength group of `pass`
+    /// (index g: the maps of group g).
     pub fn shoot(
         scene: &Scene,
-        lambda: &SampledWavelengths,
+        pw: &PassWavelengths,
         s: &PhotonMapSettings,
         pass: u64,
-    ) -> Self {
+    ) -> Vec<Self> {
         let global_keep = if s.final_gather {
             Keep::All
         } else {
@@ -279,45 +283,45 @@ impl PassMaps {
             seed: hash_u64s(&[s.seed, 0xCA05_71C5]),
             caustic_only: true,
         };
-        Self {
-            global: shoot_map(scene, lambda, &global, pass, s.photons, global_keep),
-            caustic: shoot_map(
-                scene,
-                lambda,
-                &caustic,
-                pass,
-                s.caustic_photons,
-                Keep::Caustic,
-            ),
-        }
+        let globals = shoot_map(scene, pw, &global, pass, s.photons, global_keep);
+        let caustics = shoot_map(scene, pw, &caustic, pass, s.caustic_photons, Keep::Caustic);
+        globals
+            .into_iter()
+            .zip(caustics)
+            .map(|(global, caustic)| Self { global, caustic })
+            .collect()
     }
 }
 
-/// Traces `n` photon paths of `pass` and builds a map of the hits `keep` accepts.
+/// Traces `n` photon paths of `pass` and builds, for each wavelength group
+/// of `pw`, a map of its photons' hits that `keep` accepts; photon `i`
+/// carries group `i mod G`'s wavelengths and power β/N_g.
 pub fn shoot_map(
     scene: &Scene,
-    lambda: &SampledWavelengths,
+    pw: &PassWavelengths,
     settings: &ShootSettings,
     pass: u64,
     n: u64,
     keep: Keep,
-) -> PhotonMap {
+) -> Vec<PhotonMap> {
     if n == 0 || scene.lights().is_empty() {
-        return PhotonMap::default();
+        return (0..pw.len()).map(|_| PhotonMap::default()).collect();
     }
     let inv_n = 1.0 / n as f32;
-    let chunks: Vec<Vec<Photon>> = (0..n.div_ceil(PHOTONS_PER_CHUNK))
+    let chunks: Vec<Vec<Vec<Photon>>> = (0..n.div_ceil(PHOTONS_PER_CHUNK))
         .into_par_iter()
         .map(|c| {
-            let mut out = Vec::new();
+            let mut out = vec![Vec::new(); pw.len()];
             for i in c * PHOTONS_PER_CHUNK..((c + 1) * PHOTONS_PER_CHUNK).min(n) {
-                trace_photon(scene, lambda, settings, pass, i, |h| {
+                let g = pw.photon_group(i);
+                let w = inv_n * pw.photon_scale(g, n);
+                trace_photon(scene, pw.group(g), settings, pass, i, |h| {
                     if keep.keeps(h) {
-                        out.push(Photon {
+                        out[g].push(Photon {
                             p: h.v.p(),
                             wi: h.v.wo,
                             n: h.v.it.n,
-                            power: h.v.beta * inv_n,
+                            power: h.v.beta * w,
                             depth: h.v.depth,
                         });
                     }
@@ -326,7 +330,9 @@ pub fn shoot_map(
             out
         })
         .collect();
-    PhotonMap::new(chunks.concat())
+    (0..pw.len())
+        .map(|g| PhotonMap::new(chunks.iter().flat_map(|c| c[g].iter().copied()).collect()))
+        .collect()
 }
 
 #[cfg(test)]

@@ -3,15 +3,15 @@
 //! Synthesis Using Photon Mapping", ch. 9].
 //!
 //! **Passes and wavelengths.** A render is `spp` independent passes. Pass i
-//! draws one set of four stratified wavelengths, with the offset u jittered
-//! by hash(seed, i) inside stratum i of the `spp` strata of [0, 1) (every
-//! pixel of a pass shares its wavelengths, so unstratified passes would
-//! tint the whole image at random), shoots
-//! its own global and caustic photon maps at those wavelengths (`photons`
-//! and `causticphotons` paths), builds their kd-trees, and then renders one
-//! filter-sampled camera sample per pixel with the same wavelengths, so that
-//! f·ΔΦ is formed spectrally at exactly the wavelengths the photons carry
-//! (see `photon.rs`). The film averages the passes. The rendering loop is
+//! has `wavelengthgroups` groups of four stratified wavelengths
+//! ([`crate::integrator::wavelengths`]), with the pass position u jittered
+//! by hash(seed, i) inside stratum i of the `spp` strata of [0, 1). It
+//! shoots `photons` and `causticphotons` paths, photon j at the wavelengths
+//! of group j mod G, builds a global and a caustic kd-tree per group, and
+//! then renders one filter-sampled camera sample per pixel at the
+//! wavelengths of the pixel's (hashed) group, reading that group's maps, so
+//! that f·ΔΦ is formed spectrally at exactly the wavelengths the photons
+//! carry (see `photon.rs`) while the colour noise differs between pixels. The film averages the passes. The rendering loop is
 //! parallel over 16×16 tiles and merges them in a fixed order, photons come
 //! from per-(pass, index) streams, so the image does not depend on the
 //! thread count. More passes average out noise, not the kernel bias of one
@@ -60,6 +60,7 @@
 //! | `finalgather` | bool | true | gather indirect light one bounce away |
 //! | `gatherrays` | integer | 16 | final-gather rays per non-specular camera vertex |
 //! | `maxdepth` | integer | 5 | scattering events per path |
+//! | `wavelengthgroups` | integer | 4 | wavelength groups per pass (1 to 64) |
 //!
 //! Lights are always chosen in proportion to their power.
 
@@ -68,13 +69,13 @@ mod maps;
 
 pub use maps::{Kernel, Lookup, Photon, PhotonMap};
 
+use super::wavelengths::PassWavelengths;
 use super::{
     driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext,
 };
 use crate::film::{FilmTile, PassBlock};
 use crate::math::UVec2;
 use crate::sampling::{hash_u64s, Pcg32};
-use crate::spectrum::SampledWavelengths;
 use camera::CameraSide;
 use maps::PassMaps;
 
@@ -105,6 +106,8 @@ pub struct PhotonMapSettings {
     pub gather_rays: u32,
     /// Seed of wavelengths and photons.
     pub seed: u64,
+    /// Wavelength groups per pass (`wavelengthgroups`).
+    pub wavelength_groups: u32,
 }
 
 impl Default for PhotonMapSettings {
@@ -120,6 +123,7 @@ impl Default for PhotonMapSettings {
             final_gather: true,
             gather_rays: 16,
             seed: 0,
+            wavelength_groups: super::wavelengths::DEFAULT_GROUPS,
         }
     }
 }
@@ -151,17 +155,21 @@ impl Integrator for PhotonMapIntegrator {
     ) -> PassOutcome {
         let passes = ctx.sampler.samples_per_pixel();
         let (global_lookup, caustic_lookup) = self.lookups(ctx);
-        let lambda = pass_wavelengths(self.settings.seed, pass as u32, passes);
-        let maps = PassMaps::shoot(ctx.scene, &lambda, &self.settings, pass);
-        ctx.advance(self.settings.photons + self.settings.caustic_photons);
-        let walk = CameraSide {
-            scene: ctx.scene,
-            maps: &maps,
-            settings: &self.settings,
-            global_lookup,
-            caustic_lookup,
-        };
-        let Some(tiles) = render_pass(&walk, ctx, pass as u32, &lambda) else {
+        let s = &self.settings;
+        let pw = pass_wavelengths(s.seed, pass as u32, passes, s.wavelength_groups);
+        let maps = PassMaps::shoot(ctx.scene, &pw, s, pass);
+        ctx.advance(s.photons + s.caustic_photons);
+        let walks: Vec<CameraSide<'_>> = maps
+            .iter()
+            .map(|maps| CameraSide {
+                scene: ctx.scene,
+                maps,
+                settings: s,
+                global_lookup,
+                caustic_lookup,
+            })
+            .collect();
+        let Some(tiles) = render_pass(&walks, ctx, pass as u32, &pw) else {
             return PassOutcome::Cancelled;
         };
         for tile in &tiles {
@@ -190,22 +198,25 @@ impl PhotonMapIntegrator {
     }
 }
 
-/// The wavelengths every photon and camera sample of pass `pass` of
-/// `passes` carries: the offset u is jittered in stratum `pass` of [0, 1).
-pub fn pass_wavelengths(seed: u64, pass: u32, passes: u32) -> SampledWavelengths {
+/// The wavelength groups of pass `pass` of `passes`: the pass position u
+/// is jittered in stratum `pass` of [0, 1).
+pub fn pass_wavelengths(seed: u64, pass: u32, passes: u32, groups: u32) -> PassWavelengths {
     let mut rng = Pcg32::new(hash_u64s(&[seed, u64::from(pass), 0x1A3B_DA00]), 0);
-    let u = (pass as f32 + rng.uniform_f32()) / passes as f32;
-    SampledWavelengths::sample_visible(u.min(1.0 - f32::EPSILON / 2.0))
+    let u = (f64::from(pass) + f64::from(rng.uniform_f32())) / f64::from(passes.max(1));
+    PassWavelengths::new(seed, u64::from(pass), u.min(1.0), groups)
 }
 
-/// Renders one camera sample per pixel for `pass`, tile by tile in parallel;
+/// Renders one camera sample per pixel for `pass`, tile by tile in parallel,
+/// each pixel with the camera side `walks[g]` of its wavelength group g;
 /// the tiles come back in scanline order (`None` if cancelled).
 fn render_pass(
-    walk: &CameraSide<'_>,
+    walks: &[CameraSide<'_>],
     ctx: &RenderContext<'_>,
     pass: u32,
-    lambda: &SampledWavelengths,
+    pw: &PassWavelengths,
 ) -> Option<Vec<FilmTile>> {
+    let (lo_film, hi_film) = ctx.film.pixel_bounds();
+    let width = u64::from(hi_film.x - lo_film.x);
     driver::for_each_tile(ctx, |lo, hi| {
         let mut tile = ctx.film.tile(lo, hi);
         let mut sampler = ctx.sampler.clone();
@@ -213,15 +224,17 @@ fn render_pass(
         for y in lo.y..hi.y {
             for x in lo.x..hi.x {
                 let pixel = UVec2::new(x, y);
+                let index = u64::from(y - lo_film.y) * width + u64::from(x - lo_film.x);
+                let g = pw.pixel_group(index);
                 sampler.start_pixel_sample(pixel, pass, 0);
-                // The driver's camera sample, with the pass wavelengths
+                // The driver's camera sample, with the group's wavelengths
                 // replacing the ones it draws (that draw keeps the sampler
                 // dimensions aligned with the other integrators').
                 let Some(mut cs) = driver::camera_sample(ctx, pixel, &mut sampler) else {
                     continue;
                 };
-                cs.lambda = *lambda;
-                let l = walk.li(cs.ray, &mut cs.lambda, &mut sampler, &mut scratch);
+                cs.lambda = *pw.group(g);
+                let l = walks[g].li(cs.ray, &mut cs.lambda, &mut sampler, &mut scratch);
                 tile.add_sample(pixel, l * cs.ray_weight, &cs.lambda, cs.filter_weight);
             }
         }

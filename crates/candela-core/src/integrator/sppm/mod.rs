@@ -13,7 +13,8 @@
 //! N' = N + αM, R'² = R²(N + αM)/(N + M), τ' = (τ + Φ)·R'²/R²,
 //! and the pixel is L = Ld/I + τ/(I·N_p·πR²) after I iterations of N_p
 //! photons. Φ is summed spectrally within a pass and converted to sensor RGB
-//! once per pixel and pass (the pass's wavelengths are shared).
+//! once per pixel and pass (a pixel gathers only photons of its wavelength
+//! group, [`crate::integrator::wavelengths`]).
 //!
 //! **PPM** (Knaus & Zwicker) makes every pass an independent estimate with
 //! one global radius r_i, r²_{i+1} = r²_i (i + α)/(i + 1) (closed form in
@@ -45,6 +46,9 @@ pub struct SppmSettings {
     pub max_depth: u32,
     /// Seed (`seed`).
     pub seed: u64,
+    /// Wavelength groups per pass (`wavelengthgroups`, default 4; see
+    /// [`crate::integrator::wavelengths`]).
+    pub wavelength_groups: u32,
 }
 
 impl Default for SppmSettings {
@@ -54,6 +58,7 @@ impl Default for SppmSettings {
             radius: 1.0,
             max_depth: 5,
             seed: 0,
+            wavelength_groups: super::wavelengths::DEFAULT_GROUPS,
         }
     }
 }
@@ -159,14 +164,13 @@ impl Integrator for SppmIntegrator {
         };
         let s = &self.settings;
         let pixels = pixel_list(ctx.film);
-        let lambda = pass_wavelengths(s.seed, pass);
-        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &lambda, s.max_depth) else {
+        let pw = pass_wavelengths(s.seed, pass, s.wavelength_groups);
+        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth) else {
             return PassOutcome::Cancelled;
         };
         let radius: Vec<f32> = st.stats.iter().map(|p| p.r2.sqrt() as f32).collect();
         let n = st.photons_per_iteration;
-        let Some(gathered) = photon_pass(ctx, &visits, &radius, &lambda, &s.shoot(), pass, n)
-        else {
+        let Some(gathered) = photon_pass(ctx, &visits, &radius, &pw, &s.shoot(), pass, n) else {
             return PassOutcome::Cancelled;
         };
         for ((p, v), g) in st.stats.iter_mut().zip(&visits).zip(&gathered) {

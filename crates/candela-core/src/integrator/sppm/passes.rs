@@ -22,16 +22,21 @@
 //! wall of a corner, the back of a thin sheet) are not gathered, as Jensen
 //! recommends against leaks [Jensen 2001, §7.1].
 //!
-//! Both passes use the iteration's shared wavelengths, so the photon sum Φ
-//! stays spectral until the pixel update converts it. Photon chunks return
-//! their contributions as lists merged in chunk order: deterministic.
+//! Wavelengths come in stratified groups ([`crate::integrator::wavelengths`]):
+//! a pixel's camera path carries its group's wavelengths, photon `i` those
+//! of group `i mod G` with its power scaled by N/N_g, and a visible point
+//! gathers only the photons of its group (one sphere grid per group), so
+//! the photon sum Φ stays spectral until the pixel update converts it.
+//! Photon chunks return their contributions as lists merged in chunk order:
+//! deterministic.
 
 use crate::bsdf::{Bsdf, BxdfFlags, TransportMode};
 use crate::film::Film;
 use crate::integrator::camera_walk::{camera_walk, CameraWalk};
 use crate::integrator::driver::camera_sample;
-use crate::integrator::photon::{trace_photon, ShootSettings};
+use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
 use crate::integrator::subpath::Flow;
+use crate::integrator::wavelengths::PassWavelengths;
 use crate::integrator::RenderContext;
 use crate::math::{UVec2, Vec3};
 use crate::sampler::Sampler;
@@ -61,9 +66,11 @@ pub struct VisiblePoint {
 pub struct PixelVisit {
     /// Direct light (and emission seen through specular chains).
     pub ld: SampledSpectrum,
-    /// The wavelengths of the pixel's path (the pass's, possibly with the
+    /// The wavelengths of the pixel's path (its group's, possibly with the
     /// secondary ones terminated by dispersion).
     pub lambda: SampledWavelengths,
+    /// The pixel's wavelength group in this pass.
+    pub group: usize,
     /// The visible point, if the path found one.
     pub vp: Option<VisiblePoint>,
 }
@@ -76,18 +83,22 @@ pub fn pixel_list(film: &Film) -> Vec<UVec2> {
         .collect()
 }
 
-/// The camera pass of iteration `iter` at wavelengths `lambda` (`None` if
-/// the render was cancelled meanwhile).
+/// Pixels per parallel chunk of the camera pass.
+const PIXEL_CHUNK: usize = 256;
+
+/// The camera pass of iteration `iter`, each pixel at its group's
+/// wavelengths in `pw` (`None` if the render was cancelled meanwhile).
 pub fn camera_pass(
     ctx: &RenderContext<'_>,
     pixels: &[UVec2],
     iter: u32,
-    lambda: &SampledWavelengths,
+    pw: &PassWavelengths,
     max_depth: u32,
 ) -> Option<Vec<PixelVisit>> {
     let chunks: Vec<Option<Vec<PixelVisit>>> = pixels
-        .par_chunks(256)
-        .map(|chunk| {
+        .par_chunks(PIXEL_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
             if ctx.cancelled() {
                 return None;
             }
@@ -95,9 +106,14 @@ pub fn camera_pass(
             Some(
                 chunk
                     .iter()
-                    .map(|&pixel| {
+                    .enumerate()
+                    .map(|(k, &pixel)| {
+                        let group = pw.pixel_group((c * PIXEL_CHUNK + k) as u64);
                         sampler.start_pixel_sample(pixel, iter, 0);
-                        visit_pixel(ctx, pixel, lambda, max_depth, &mut sampler)
+                        let lambda = pw.group(group);
+                        let mut v = visit_pixel(ctx, pixel, lambda, max_depth, &mut sampler);
+                        v.group = group;
+                        v
                     })
                     .collect(),
             )
@@ -119,6 +135,7 @@ fn visit_pixel(
     let mut visit = PixelVisit {
         ld: SampledSpectrum::zero(),
         lambda: *lambda,
+        group: 0,
         vp: None,
     };
     let Some(cs) = camera_sample(ctx, pixel, sampler) else {
@@ -183,26 +200,31 @@ pub struct Gathered {
 const CHUNK: u64 = 4096;
 
 /// Shoots `n_photons` photons of pass `pass` and gathers them at the visible
-/// points, each with its own radius `radius[i]` (`None` if cancelled).
+/// points of their wavelength group, each with its own radius `radius[i]`
+/// (`None` if cancelled).
 pub fn photon_pass(
     ctx: &RenderContext<'_>,
     visits: &[PixelVisit],
     radius: &[f32],
-    lambda: &SampledWavelengths,
+    pw: &PassWavelengths,
     shoot: &ShootSettings,
     pass: u64,
     n_photons: u64,
 ) -> Option<Vec<Gathered>> {
     let scene = ctx.scene;
-    let spheres: Vec<Sphere> = visits
-        .iter()
-        .zip(radius)
-        .map(|(v, &r)| match v.vp {
-            Some(vp) => Sphere(vp.p, r),
-            None => Sphere(Vec3::ZERO, -1.0),
+    let grids: Vec<SphereGrid> = (0..pw.len())
+        .map(|g| {
+            let spheres: Vec<Sphere> = visits
+                .iter()
+                .zip(radius)
+                .map(|(v, &r)| match v.vp {
+                    Some(vp) if v.group == g => Sphere(vp.p, r),
+                    _ => Sphere(Vec3::ZERO, -1.0),
+                })
+                .collect();
+            SphereGrid::build(&spheres)
         })
         .collect();
-    let grid = SphereGrid::build(&spheres);
     let lists: Vec<Option<Vec<(u32, SampledSpectrum)>>> = (0..n_photons.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
@@ -211,25 +233,18 @@ pub fn photon_pass(
             }
             let mut out = Vec::new();
             for i in c * CHUNK..((c + 1) * CHUNK).min(n_photons) {
-                trace_photon(scene, lambda, shoot, pass, i, |h| {
+                let g = pw.photon_group(i);
+                let scale = pw.photon_scale(g, n_photons);
+                trace_photon(scene, pw.group(g), shoot, pass, i, |h| {
                     if h.v.depth < 2 {
                         return; // direct light: the camera pass's NEE
                     }
-                    grid.for_each_containing(h.v.p(), |j| {
-                        let Some(vp) = &visits[j as usize].vp else {
-                            return;
-                        };
-                        let n_p = h.v.it.n;
-                        if n_p.dot(vp.n) <= 0.0 {
-                            return;
+                    grids[g].for_each_containing(h.v.p(), |j| {
+                        if let Some(vp) = &visits[j as usize].vp {
+                            if let Some(phi) = photon_contribution(vp, h) {
+                                out.push((j, phi * scale));
+                            }
                         }
-                        let wi = rotate_between(h.v.wo, n_p, vp.n);
-                        let f = vp.bsdf.f(vp.wo, wi, TransportMode::Radiance);
-                        let mut phi = h.v.beta * f;
-                        if vp.terminated {
-                            phi = hero_only(phi, h.terminated);
-                        }
-                        out.push((j, phi));
                     });
                 });
             }
@@ -247,6 +262,22 @@ pub fn photon_pass(
         }
     }
     Some(gathered)
+}
+
+/// β_p·f(x, ωp → ωo) of a photon hit `h` inside the sphere of `vp`, or
+/// `None` when the photon is not counted (module doc).
+fn photon_contribution(vp: &VisiblePoint, h: &PhotonHit<'_>) -> Option<SampledSpectrum> {
+    let n_p = h.v.it.n;
+    if n_p.dot(vp.n) <= 0.0 {
+        return None;
+    }
+    let wi = rotate_between(h.v.wo, n_p, vp.n);
+    let f = vp.bsdf.f(vp.wo, wi, TransportMode::Radiance);
+    let mut phi = h.v.beta * f;
+    if vp.terminated {
+        phi = hero_only(phi, h.terminated);
+    }
+    Some(phi)
 }
 
 /// Applies the rotation taking unit vector `a` to unit vector `b` (a·b > 0)
@@ -273,13 +304,14 @@ fn hero_only(phi: SampledSpectrum, photon_terminated: bool) -> SampledSpectrum {
     })
 }
 
-/// The wavelengths of pass `pass`: a golden-ratio sequence offset by the
-/// seed, so successive passes stratify the visible range.
-pub fn pass_wavelengths(seed: u64, pass: u64) -> SampledWavelengths {
+/// The wavelength groups of pass `pass`: the pass position u follows a
+/// golden-ratio sequence offset by the seed, so successive passes
+/// stratify the visible range.
+pub fn pass_wavelengths(seed: u64, pass: u64, groups: u32) -> PassWavelengths {
     let offset =
         (crate::sampling::hash_u64s(&[seed, 0x5350_504d]) >> 11) as f64 / (1u64 << 53) as f64;
     let u = (offset + pass as f64 * 0.618_033_988_749_895).fract();
-    SampledWavelengths::sample_visible(u as f32)
+    PassWavelengths::new(seed, pass, u, groups)
 }
 
 #[cfg(test)]

@@ -28,6 +28,9 @@ pub struct PpmSettings {
     pub max_depth: u32,
     /// Seed (`seed`).
     pub seed: u64,
+    /// Wavelength groups per pass (`wavelengthgroups`, default 4; see
+    /// [`crate::integrator::wavelengths`]).
+    pub wavelength_groups: u32,
 }
 
 /// The PPM integrator.
@@ -85,13 +88,13 @@ impl Integrator for PpmIntegrator {
             seed: st.seed,
             caustic_only: false,
         };
-        let lambda = pass_wavelengths(st.seed, pass);
-        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &lambda, st.max_depth) else {
+        let pw = pass_wavelengths(st.seed, pass, st.wavelength_groups);
+        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &pw, st.max_depth) else {
             return PassOutcome::Cancelled;
         };
         let r2 = self.radius2(pass);
         let radius = vec![r2.sqrt() as f32; pixels.len()];
-        let Some(gathered) = photon_pass(ctx, &visits, &radius, &lambda, &shoot, pass, n_photons)
+        let Some(gathered) = photon_pass(ctx, &visits, &radius, &pw, &shoot, pass, n_photons)
         else {
             return PassOutcome::Cancelled;
         };
