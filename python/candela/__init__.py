@@ -26,8 +26,10 @@ from ._native import (
     scene_files,
     state_info,
 )
+from . import archive
 
 __all__ = [
+    "archive",
     "CandelaError",
     "Render",
     "Scene",

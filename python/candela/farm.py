@@ -69,7 +69,7 @@ def _scene(data: bytes, digest: str, settings: dict):
     try:
         scene = _native.load(path, **settings)
     except _native.SceneError as e:
-        e.archive_root = root
+        setattr(e, "archive_root", root)  # read back by _localize on the client
         raise
     with _scenes_lock:
         _scenes.setdefault(digest, scene)
