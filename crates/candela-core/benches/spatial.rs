@@ -142,10 +142,23 @@ fn bench_spatial(c: &mut Criterion) {
                 .sum::<f32>()
         })
     });
+    bench_radius_queries(&mut g, &tree, &grid, &pts, &qs, radius);
+    g.finish();
+}
+
+/// Fixed-radius queries: kd-tree, hash grids with cells of 2r and r, sphere grid.
+fn bench_radius_queries(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    tree: &PointKdTree<Vec3>,
+    grid: &HashGrid,
+    pts: &[Vec3],
+    qs: &[Vec3],
+    radius: f32,
+) {
     g.bench_function("kdtree_radius", |b| {
         b.iter(|| {
             let mut n = 0usize;
-            for &q in &qs {
+            for &q in qs {
                 tree.for_each_within(q, radius, |_, _| n += 1);
             }
             n
@@ -154,34 +167,33 @@ fn bench_spatial(c: &mut Criterion) {
     g.bench_function("hash_grid_radius", |b| {
         b.iter(|| {
             let mut n = 0usize;
-            for &q in &qs {
+            for &q in qs {
                 grid.for_each_within(q, radius, |_, _| n += 1);
             }
             n
         })
     });
     // Cells of r instead of 2r: 27 cells per query, but fewer points each.
-    let fine_grid = HashGrid::with_cell_size(&pts, radius);
+    let fine_grid = HashGrid::with_cell_size(pts, radius);
     g.bench_function("hash_grid_radius_cell_r", |b| {
         b.iter(|| {
             let mut n = 0usize;
-            for &q in &qs {
+            for &q in qs {
                 fine_grid.for_each_within(q, radius, |_, _| n += 1);
             }
             n
         })
     });
-    let sphere_grid = SphereGrid::build(&spheres(&pts));
+    let sphere_grid = SphereGrid::build(&spheres(pts));
     g.bench_function("sphere_grid_containing", |b| {
         b.iter(|| {
             let mut n = 0usize;
-            for &q in &qs {
+            for &q in qs {
                 sphere_grid.for_each_containing(q, |_| n += 1);
             }
             n
         })
     });
-    g.finish();
 }
 
 criterion_group!(benches, bench_spatial);

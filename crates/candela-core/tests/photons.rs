@@ -40,7 +40,7 @@ fn first_hits(rs: &RenderSetup, n: u64) -> Vec<(f32, f32)> {
         .filter_map(|i| {
             let mut hit = None;
             trace_photon(&rs.scene, &lambda, &settings, 0, i, |h| {
-                hit = Some((h.si.p().truncate().length(), h.beta.0[0]));
+                hit = Some((h.v.p().truncate().length(), h.v.beta.0[0]));
             });
             hit
         })
@@ -115,7 +115,7 @@ Shape "sphere" "float radius" [1]
         .map(|i| {
             let mut incident = 0.0f64;
             let fate = trace_photon(&rs.scene, &lambda, &settings, 3, i, |h| {
-                incident += h.beta.0[0] as f64;
+                incident += h.v.beta.0[0] as f64;
             });
             (fate.absorbed.0[0] as f64, incident)
         })

@@ -52,8 +52,8 @@ Shape "trianglemesh" "point3 P" [-1000 -1000 0  1000 -1000 0  1000 1000 0  -1000
             let mut sum = 0.0f64;
             for i in 0..n {
                 trace_photon(&rs.scene, &lambda, &settings, pass, i, |h| {
-                    if (h.si.p().truncate().length_squared() as f64) < r2 {
-                        sum += h.beta.0[0] as f64 / n as f64;
+                    if (h.v.p().truncate().length_squared() as f64) < r2 {
+                        sum += h.v.beta.0[0] as f64 / n as f64;
                     }
                 });
             }

@@ -213,7 +213,7 @@ fn bad_shape_parameters_are_errors_with_locations() {
     let cases = [
         (
             r#"Shape "loopsubdiv" "integer levels" [-1] "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 2]"#,
-            "must be ≥ 0",
+            "\"levels\" must be at least 0, found -1",
         ),
         (
             r#"Shape "loopsubdiv" "point3 P" [0 0 0 1 0 0 0 1 0 0 0 1] "integer indices" [0 1 2 0 1 3 1 0 3]"#,

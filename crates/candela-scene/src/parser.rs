@@ -159,6 +159,12 @@ impl Parser {
             }
             b"Rotate" => {
                 let [a, x, y, z] = self.numbers("Rotate")?;
+                if x == 0.0 && y == 0.0 && z == 0.0 {
+                    return Err(SceneError::at(
+                        loc,
+                        "Rotate: the axis (0, 0, 0) has no direction",
+                    ));
+                }
                 self.b.apply(|m| *m * Mat4d::rotate(a, [x, y, z]));
             }
             b"LookAt" => self.look_at(loc)?,
@@ -298,6 +304,10 @@ impl Parser {
                 .ok()
                 .and_then(|s| s.parse().ok());
             match (t.kind, parsed) {
+                (TokenKind::Word, Some(x)) if !f64::is_finite(x) => {
+                    let msg = format!("{directive}: {x} is not a finite number");
+                    return Err(SceneError::at(&lx.loc(&t), msg));
+                }
                 (TokenKind::Word, Some(x)) => *v = x,
                 _ => {
                     let msg = format!(

@@ -2,6 +2,7 @@
 //! (parsing) and `candela-core` (building, the render loop, the film).
 
 mod info;
+mod live;
 mod output;
 mod progress;
 mod render_cmd;

@@ -39,7 +39,7 @@ pub fn check_writable(exr: &Path) -> Result<()> {
 /// The developed channels as EXR layers: a channel name `layer.C` goes to
 /// layer `layer` as channel `C` (the part after the last '.'), others to the
 /// root layer, so readers see pbrt-v4's and candela's channel names.
-fn layers(dev: &Developed) -> Vec<ExrLayer> {
+pub fn layers(dev: &Developed) -> Vec<ExrLayer> {
     let mut out: Vec<ExrLayer> = Vec::new();
     for ch in &dev.channels {
         let (layer, name) = ch.name.rsplit_once('.').unwrap_or(("", ch.name.as_str()));

@@ -1,10 +1,12 @@
 //! `candela render` and `candela merge`: flags → render loop → outputs.
 
+use crate::live::Live;
 use crate::output;
 use crate::progress;
 use anyhow::{bail, Context, Result};
 use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::film::develop::develop;
+use candela_core::film::Aov;
 use candela_core::integrator::{IntegratorKind, Visualize};
 use candela_core::render::{self, RenderOptions, RenderState, StopReason};
 use std::path::{Path, PathBuf};
@@ -111,6 +113,40 @@ pub struct RenderArgs {
     /// channel, from the spread of the per-pass means) is below this.
     #[arg(long, value_parser = parse_error)]
     pub target_error: Option<f64>,
+    /// Extra EXR layers, comma-separated. First-hit values (of each pass's
+    /// camera ray, followed through interface materials to the first
+    /// surface with a BSDF; filter-weighted averages, rays that escape
+    /// count as 0): `albedo` (albedo.R/G/B: directional reflectance ρ(wo)
+    /// times the colour space's illuminant, output RGB), `position`
+    /// (position.X/Y/Z, world space), `normal` and `shading_normal`
+    /// (normal.X/Y/Z, shading_normal.X/Y/Z: unit, world space, facing the
+    /// camera), `depth` (depth.Z: distance from the lens point), `uv`
+    /// (uv.U/V: surface coordinates), `dzdxy` (dzdx, dzdy: |change of
+    /// camera-space z| per pixel). `variance` (variance.R/G/B): variance of
+    /// each pixel's value, from the spread of the independent passes
+    /// (s²/n; needs 2 passes).
+    #[arg(long, value_parser = parse_aovs)]
+    pub aov: Option<AovList>,
+    /// Show the image in the tev viewer listening at HOST:PORT while it
+    /// renders (tev's default is 127.0.0.1:14158): every channel of the
+    /// EXR, at most 4 frames a second, never blocking the render; the
+    /// final image is always sent.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub display_server: Option<String>,
+    /// Refuse to start a render whose film, photon and other large
+    /// structures are estimated above this size ("4G", "512MiB", "50%";
+    /// default: 75% of physical memory).
+    #[arg(long, value_parser = candela_core::build::parse_memory)]
+    pub memory_limit: Option<u64>,
+}
+
+/// The layers of `--aov` (one value to clap, not a list of values).
+#[derive(Clone, Debug)]
+pub struct AovList(Vec<Aov>);
+
+/// Parses an `--aov` list.
+fn parse_aovs(s: &str) -> Result<AovList, String> {
+    Aov::parse_list(s).map(AovList)
 }
 
 impl RenderArgs {
@@ -122,6 +158,8 @@ impl RenderArgs {
             outfile: self.outfile.clone(),
             seed: self.seed,
             cropwindow: self.cropwindow,
+            aovs: self.aov.clone().map(|a| a.0).unwrap_or_default(),
+            memory_limit: self.memory_limit,
         }
     }
 }
@@ -154,6 +192,9 @@ fn settings_text(ov: &Overrides) -> String {
     if let Some([a, b, c, d]) = ov.cropwindow {
         s.push_str(&format!("cropwindow={a:?},{b:?},{c:?},{d:?}\n"));
     }
+    if !ov.aovs.is_empty() {
+        s.push_str(&format!("aov={}\n", Aov::list_text(&ov.aovs)));
+    }
     s
 }
 
@@ -171,6 +212,7 @@ fn overrides_from(text: &str) -> Result<Overrides> {
             "cropwindow" => {
                 ov.cropwindow = Some(parse_cropwindow(v).map_err(anyhow::Error::msg)?);
             }
+            "aov" => ov.aovs = Aov::parse_list(v).map_err(anyhow::Error::msg)?,
             _ => bail!("unknown setting {k:?} in the state file"),
         }
     }
@@ -230,43 +272,25 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     }
     let exr = output::exr_path(&setup.outfile)?;
     output::check_writable(&exr)?;
-    let total = setup.sampler.samples_per_pixel() as u64;
-    let passes = args.pass_range.unwrap_or((0, total));
-    if passes.1 > total {
-        bail!(
-            "--pass-range {}..{} goes past the {total} passes of the render (set --spp)",
-            passes.0,
-            passes.1
-        );
-    }
-    let kind = setup.integrator.kind();
-    if args.pass_range.is_some() && !kind.independent_passes() {
-        bail!("--pass-range: {kind}'s passes depend on each other and cannot be split (use ppm, or --checkpoint and --resume)");
-    }
-    let fp = render::fingerprint(&desc, &ov, setup.film.layout());
-    let mut state = match &args.resume {
-        Some(path) => resumed(path, fp, total, kind)?,
-        None => render::new_state(&setup, fp, total, &settings_text(&ov)),
-    };
-    let partial = args.pass_range.map(|(a, b)| {
-        args.checkpoint
-            .clone()
-            .unwrap_or_else(|| exr.with_extension(format!("passes-{a}-{b}.cndl")))
-    });
-    let checkpoint = partial
-        .clone()
-        .or_else(|| args.checkpoint.clone())
-        .unwrap_or_else(|| exr.with_extension("cndl"));
-    let opts = RenderOptions {
-        passes,
-        time_limit: args.time_limit.map(Duration::from_secs_f64),
-        target_error: args.target_error,
-        checkpoint: Some(checkpoint.clone()),
-        checkpoint_every: args.checkpoint_every.map(Duration::from_secs_f64),
-    };
+    let (mut state, opts, partial) = plan(&args, &desc, &setup, &ov, &exr)?;
+    let checkpoint = opts.checkpoint.clone().unwrap_or_default();
     let load_time = t0.elapsed();
     let display = progress::display(args.quiet);
-    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |_| {})?;
+    let name = args
+        .scene
+        .file_name()
+        .map_or("candela".into(), |n| n.to_string_lossy().to_string());
+    let mut live = args
+        .display_server
+        .as_deref()
+        .map(|a| Live::start(a, &name))
+        .transpose()?;
+    let outcome = render::render(&setup, &mut state, &opts, &stop, &display, &mut |st| {
+        if let Some(l) = live.as_mut() {
+            l.after_pass(&setup, st);
+        }
+    })?;
+    let live_report = live.map(|l| l.finish(&setup, &state));
     write_image(&setup, &state, &exr)?;
     let stopped_early = outcome.reason != StopReason::Finished;
     let write_state = partial.is_some() || args.checkpoint.is_some() || stopped_early;
@@ -288,6 +312,14 @@ pub fn render(args: RenderArgs) -> Result<i32> {
         &exr,
         write_state.then_some(&checkpoint),
     );
+    if let (Some(r), false) = (live_report, args.quiet) {
+        eprintln!(
+            "candela: live view: {} frames ({} delivered), {:.1} ms each to develop",
+            r.frames,
+            r.delivered,
+            r.mean_build.as_secs_f64() * 1e3
+        );
+    }
     Ok(
         if outcome.reason == StopReason::Interrupted || stop.load(Ordering::Relaxed) {
             EXIT_INTERRUPTED
@@ -295,6 +327,52 @@ pub fn render(args: RenderArgs) -> Result<i32> {
             0
         },
     )
+}
+
+/// The state to start from, the loop's options and the partial-state path
+/// (with `--pass-range`) of a render.
+fn plan(
+    args: &RenderArgs,
+    desc: &candela_scene::SceneDescription,
+    setup: &RenderSetup,
+    ov: &Overrides,
+    exr: &Path,
+) -> Result<(RenderState, RenderOptions, Option<PathBuf>)> {
+    let total = setup.sampler.samples_per_pixel() as u64;
+    let passes = args.pass_range.unwrap_or((0, total));
+    if passes.1 > total {
+        bail!(
+            "--pass-range {}..{} goes past the {total} passes of the render (set --spp)",
+            passes.0,
+            passes.1
+        );
+    }
+    let kind = setup.integrator.kind();
+    if args.pass_range.is_some() && !kind.independent_passes() {
+        bail!("--pass-range: {kind}'s passes depend on each other and cannot be split (use ppm, or --checkpoint and --resume)");
+    }
+    let fp = render::fingerprint(desc, ov, setup.film.layout());
+    let state = match &args.resume {
+        Some(path) => resumed(path, fp, total, kind)?,
+        None => render::new_state(setup, fp, total, &settings_text(ov)),
+    };
+    let partial = args.pass_range.map(|(a, b)| {
+        args.checkpoint
+            .clone()
+            .unwrap_or_else(|| exr.with_extension(format!("passes-{a}-{b}.cndl")))
+    });
+    let checkpoint = partial
+        .clone()
+        .or_else(|| args.checkpoint.clone())
+        .unwrap_or_else(|| exr.with_extension("cndl"));
+    let opts = RenderOptions {
+        passes,
+        time_limit: args.time_limit.map(Duration::from_secs_f64),
+        target_error: args.target_error,
+        checkpoint: Some(checkpoint),
+        checkpoint_every: args.checkpoint_every.map(Duration::from_secs_f64),
+    };
+    Ok((state, opts, partial))
 }
 
 /// The state in checkpoint `path`, checked against this render.

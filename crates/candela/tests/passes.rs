@@ -142,6 +142,67 @@ fn uneven_pass_ranges_merge_into_the_bytes_of_one_run_for_every_integrator() {
     }
 }
 
+/// With layers (first-hit values, variance, spectral buckets, pbrt-v4's
+/// gbuffer) pass ranges still merge into the bytes of one run: the merge
+/// rebuilds the layers from the `aov=` setting stored in the parts.
+#[test]
+fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
+    let cases = [
+        (
+            "aov-path",
+            r#""path" "integer maxdepth" [5]"#,
+            "rgb",
+            "albedo,depth,normal,uv,dzdxy,variance",
+        ),
+        (
+            "aov-ppm",
+            INTEGRATORS[3].1,
+            "rgb",
+            "position,shading_normal,variance",
+        ),
+        ("gbuffer-bdpt", INTEGRATORS[2].1, "gbuffer", ""),
+        ("spectral-lightpath", INTEGRATORS[1].1, "spectral", "albedo"),
+    ];
+    for (name, directive, film, aov) in cases {
+        let d = tmpdir(name);
+        let s = d.join("s.pbrt");
+        let text = scene(directive).replace(r#"Film "rgb""#, &format!(r#"Film "{film}""#));
+        std::fs::write(&s, text).unwrap();
+        let mut flags = vec!["--spp", "5"];
+        if !aov.is_empty() {
+            flags.extend(["--aov", aov]);
+        }
+        run(&s, &flags, &d.join("full.exr"));
+        for (a, b) in [(0, 2), (2, 5)] {
+            let r = format!("{a}..{b}");
+            let mut f = flags.clone();
+            f.extend(["--pass-range", &r]);
+            run(&s, &f, &d.join(format!("p{a}.exr")));
+        }
+        let o = candela()
+            .arg("merge")
+            .arg(&s)
+            .args(["p2.passes-2-5.cndl", "p0.passes-0-2.cndl"].map(|p| d.join(p)))
+            .arg("-o")
+            .arg(d.join("merged.exr"))
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let full = bytes(&d.join("full.exr"));
+        assert!(
+            bytes(&d.join("merged.exr")) == full,
+            "{name}: merged EXR differs from one run"
+        );
+        let layers = candela_core::image::read_exr_layers(&d.join("full.exr")).unwrap();
+        assert!(layers.layers.len() > 1, "{name}: no layers written");
+        std::fs::remove_dir_all(&d).ok();
+    }
+}
+
 #[test]
 fn one_and_two_threads_write_the_same_bytes() {
     let mut all = INTEGRATORS.to_vec();
@@ -223,7 +284,13 @@ fn sigint_writes_image_and_checkpoint_and_resume_gives_the_uninterrupted_bytes()
         "resumed render differs from an uninterrupted one"
     );
 
-    // A checkpoint of another scene, of other flags, or truncated, is refused.
+    refusals(&d, &s, &ckpt, &args);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A checkpoint of another scene, of other flags, truncated or not a
+/// checkpoint at all is refused with a message, and no image is written.
+fn refusals(d: &Path, s: &Path, ckpt: &Path, args: &[&str]) {
     let other = d.join("other.pbrt");
     std::fs::write(&other, scene(r#""path" "integer maxdepth" [4]"#)).unwrap();
     let refuse = |scene: &Path, ckpt: &Path, extra: &[&str], word: &str| {
@@ -245,18 +312,12 @@ fn sigint_writes_image_and_checkpoint_and_resume_gives_the_uninterrupted_bytes()
             "a refused resume wrote an image"
         );
     };
-    refuse(&other, &ckpt, &args, "another scene");
-    refuse(
-        &s,
-        &ckpt,
-        &["--spp", "4000", "--seed", "3"],
-        "another scene",
-    );
+    refuse(&other, ckpt, args, "another scene");
+    refuse(s, ckpt, &["--spp", "4000", "--seed", "3"], "another scene");
     let cut = d.join("cut.cndl");
-    let full = bytes(&ckpt);
+    let full = bytes(ckpt);
     std::fs::write(&cut, &full[..full.len() / 2]).unwrap();
-    refuse(&s, &cut, &args, "truncated or damaged");
+    refuse(s, &cut, args, "truncated or damaged");
     std::fs::write(&cut, b"not a checkpoint at all, just text").unwrap();
-    refuse(&s, &cut, &args, "not a candela render state");
-    std::fs::remove_dir_all(&d).ok();
+    refuse(s, &cut, args, "not a candela render state");
 }

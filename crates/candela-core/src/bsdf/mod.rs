@@ -374,6 +374,20 @@ impl Bsdf {
     pub fn regularize(&mut self) {
         self.bxdf.regularize()
     }
+    /// Directional albedo ρ(wo) for a world-space `wo` ([`Bxdf::rho`]).
+    pub fn rho(
+        &self,
+        wo_render: Vec3,
+        uc: &[f32],
+        u: &[Vec2],
+        mode: TransportMode,
+    ) -> SampledSpectrum {
+        let wo = self.to_local(wo_render);
+        if wo.z == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        self.bxdf.rho(wo, uc, u, mode)
+    }
 }
 
 fn allowed_lobes(allowed: SampleFlags) -> BxdfFlags {

@@ -1,6 +1,7 @@
 //! The coated materials, `coateddiffuse` and `coatedconductor`, with pbrt-v4's
 //! parameter names and defaults (pbrt-v4 `materials.cpp`).
 
+use super::check::{Check, Domain};
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::textures::{Source, Textures};
 use super::BuildError;
@@ -17,6 +18,15 @@ fn roughness(src: &Source, tex: &mut Textures, prefix: &str) -> Result<Roughness
         (Some(_), Some(_)) => FloatTexture::Constant(0.0),
         _ => tex.float(src, &format!("{prefix}roughness"), 0.0)?,
     };
+    for (name, t) in [
+        ("uroughness", &u),
+        ("vroughness", &v),
+        ("roughness", &Some(common.clone())),
+    ] {
+        if let Some(t) = t {
+            constant_in(src, &format!("{prefix}{name}"), t, Domain::NonNegative)?;
+        }
+    }
     Ok(Roughness {
         u: u.unwrap_or_else(|| common.clone()),
         v: v.unwrap_or(common),
@@ -24,16 +34,28 @@ fn roughness(src: &Source, tex: &mut Textures, prefix: &str) -> Result<Roughness
     })
 }
 
+/// Checks of a material's parameters.
+fn check<'a>(src: &'a Source) -> Check<'a> {
+    Check::new(src.params, src.loc, "Material")
+}
+
 /// A non-negative integer parameter that must be at least `min`.
 fn count(src: &Source, name: &str, default: i32, min: i32) -> Result<u32, BuildError> {
-    let v = src.params.get_int(name, default)?;
-    if v < min {
-        return Err(BuildError::at(
-            src.loc,
-            format!("\"{name}\" must be at least {min}, found {v}"),
-        ));
+    Ok(check(src).int(name, default, min)? as u32)
+}
+
+/// Fails when texture parameter `name` is a constant outside `d` (textures
+/// that vary are evaluated per hit and cannot be checked here).
+pub fn constant_in(
+    src: &Source,
+    name: &str,
+    t: &FloatTexture,
+    d: Domain,
+) -> Result<(), BuildError> {
+    if let FloatTexture::Constant(x) = t {
+        check(src).domain(name, *x, d)?;
     }
-    Ok(v as u32)
+    Ok(())
 }
 
 /// Index of refraction `name`: a float or a spectrum (pbrt-v4 accepts both), default 1.5.
@@ -48,7 +70,12 @@ pub fn eta_param(src: &Source, name: &str) -> Result<Spectrum, BuildError> {
         .transpose()?
         .flatten()
     {
-        return Ok(Spectrum::Constant(v.first().copied().unwrap_or(1.5)));
+        let eta = v.first().copied().unwrap_or(1.5);
+        return Ok(Spectrum::Constant(check(src).domain(
+            name,
+            eta,
+            Domain::Positive,
+        )?));
     }
     Ok(
         spectrum_param(src.params, name, SpectrumKind::Unbounded, src.cs)?
@@ -59,12 +86,16 @@ pub fn eta_param(src: &Source, name: &str) -> Result<Spectrum, BuildError> {
 /// The coating and medium shared by both materials; `interface` is the
 /// parameter prefix of the coating's roughness and index ("" or "interface.").
 fn coating(src: &Source, tex: &mut Textures, interface: &str) -> Result<Coating, BuildError> {
+    let thickness = tex.float(src, "thickness", 0.01)?;
+    constant_in(src, "thickness", &thickness, Domain::Positive)?;
+    let g = tex.float(src, "g", 0.0)?;
+    constant_in(src, "g", &g, Domain::Open(-1.0, 1.0))?;
     Ok(Coating {
         eta: eta_param(src, &format!("{interface}eta"))?,
         roughness: roughness(src, tex, interface)?,
-        thickness: tex.float(src, "thickness", 0.01)?,
+        thickness,
         albedo: tex.spectrum(src, "albedo", SpectrumKind::Albedo, 0.0)?,
-        g: tex.float(src, "g", 0.0)?,
+        g,
         max_depth: count(src, "maxdepth", 10, 0)?,
         n_samples: count(src, "nsamples", 1, 1)?,
     })

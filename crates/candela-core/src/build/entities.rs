@@ -1,12 +1,14 @@
 //! Camera, film, pixel filter, sampler and integrator from their directives.
 
+use super::budget::Budget;
+use super::check::{Check, Domain};
 use super::{BuildError, Overrides};
 use crate::camera::{Camera, CameraParams, SphericalCamera, SphericalMapping};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
-use crate::film::{Film, FilmSettings};
+use crate::film::{Buckets, Film, FilmKind, FilmLayout, FilmSettings, SurfaceAov, SurfaceSpace};
 use crate::math::{Transform, UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
-use crate::spectrum::{ColorSpace, PixelSensor};
+use crate::spectrum::{ColorSpace, PixelSensor, LAMBDA_MAX, LAMBDA_MIN};
 use candela_scene::SceneDescription;
 use std::path::PathBuf;
 
@@ -22,34 +24,17 @@ fn transform(
 pub fn film(
     desc: &SceneDescription,
     ov: &Overrides,
-    warnings: &mut Vec<String>,
+    budget: &mut Budget,
 ) -> Result<(Film, PathBuf), BuildError> {
     let empty = super::default_entity("rgb");
     let e = desc.film.as_ref().unwrap_or(&empty);
     let p = &e.params;
-    match e.name.as_str() {
-        "rgb" => {}
-        // Same RGB image as "rgb"; the extra outputs are left out.
-        "gbuffer" => {
-            let _ = p.get_string("coordinatesystem", "camera")?;
-            warnings.push(format!("{}: film \"gbuffer\" is written as \"rgb\": the auxiliary channels (albedo, normals, depth, variance) are not written", e.loc));
-        }
-        "spectral" => {
-            let _ = p.get_int("nbuckets", 16)?;
-            let _ = p.get_float("lambdamin", 360.0)?;
-            let _ = p.get_float("lambdamax", 830.0)?;
-            warnings.push(format!("{}: film \"spectral\" is written as \"rgb\": the spectral channels are not written", e.loc));
-        }
-        other => {
-            return Err(BuildError::at(
-                &e.loc,
-                format!("film \"{other}\" is not supported (supported: \"rgb\"; \"gbuffer\" and \"spectral\" are written as \"rgb\")"),
-            ))
-        }
-    }
+    let what = format!("Film \"{}\"", e.name);
+    let ck = Check::new(p, &e.loc, &what);
+    let (layout, kind, space) = film_layers(e, ov)?;
     let res = UVec2::new(
-        p.get_int("xresolution", 1280)?.max(1) as u32,
-        p.get_int("yresolution", 720)?.max(1) as u32,
+        ck.int("xresolution", 1280, 1)? as u32,
+        ck.int("yresolution", 720, 1)? as u32,
     );
     let filename = p.get_string("filename", "pbrt.exr")?;
     let outfile = ov
@@ -63,24 +48,13 @@ pub fn film(
         }
         None => pixel_bounds(p, res, &e.loc)?,
     };
-    let max_component_value = p.get_float("maxcomponentvalue", f32::INFINITY)?;
+    let max_component_value = ck.float("maxcomponentvalue", f32::INFINITY, Domain::Positive)?;
     let _ = p.get_bool("savefp16", true)?; // candela always writes 32-bit float EXR.
-    let iso = p.get_float("iso", 100.0)?;
+    let iso = ck.float("iso", 100.0, Domain::Positive)?;
     let exposure_time = camera_exposure(desc)?;
     let sensor_name = p.get_string("sensor", "cie1931")?;
-    let white_balance = p.get_float("whitebalance", 0.0)?;
-    if !(white_balance >= 0.0 && white_balance.is_finite()) {
-        return Err(BuildError::at(
-            &e.loc,
-            format!("\"whitebalance\" must be a temperature in K (0: none), found {white_balance}"),
-        ));
-    }
-    if !(iso >= 0.0 && iso.is_finite()) {
-        return Err(BuildError::at(
-            &e.loc,
-            format!("\"iso\" must be non-negative, found {iso}"),
-        ));
-    }
+    // A temperature in K; 0 means no white balance.
+    let white_balance = ck.float("whitebalance", 0.0, Domain::NonNegative)?;
     let cs = ColorSpace::by_name(&e.color_space).ok_or_else(|| {
         BuildError::at(&e.loc, format!("unknown color space \"{}\"", e.color_space))
     })?;
@@ -88,16 +62,92 @@ pub fn film(
         PixelSensor::from_name(&sensor_name, cs, white_balance, exposure_time * iso / 100.0)
             .map_err(|err| BuildError::at(&e.loc, err.to_string()))?;
     let output_from_sensor = cs.rgb_from_xyz * sensor.xyz_from_sensor_rgb();
-    let filter = filter(desc)?;
+    let filter = filter(desc, budget)?;
     let settings = FilmSettings {
         resolution: res,
         pixel_bounds,
         max_component_value,
     };
-    Ok((
-        Film::new(settings, filter, sensor, output_from_sensor),
-        outfile,
-    ))
+    let film = Film::new(settings, filter, sensor, output_from_sensor)
+        .with_layers(layout, kind, space)
+        .with_color_space(cs);
+    Ok((film, outfile))
+}
+
+/// Longest list of spectral buckets (each costs two sums per pixel).
+const MAX_BUCKETS: i32 = 1024;
+
+/// The layers of the `Film` directive's kind [pbrt-v4 `GBufferFilm`,
+/// `SpectralFilm`] and of `--aov`.
+fn film_layers(
+    e: &candela_scene::Entity,
+    ov: &Overrides,
+) -> Result<(FilmLayout, FilmKind, SurfaceSpace), BuildError> {
+    let p = &e.params;
+    let (layout, kind, space) = match e.name.as_str() {
+        "rgb" => (FilmLayout::default(), FilmKind::Rgb, SurfaceSpace::World),
+        "gbuffer" => {
+            let space = match p.get_string("coordinatesystem", "camera")?.as_str() {
+                "camera" => SurfaceSpace::Camera,
+                "world" => SurfaceSpace::World,
+                other => {
+                    let loc = p.param_loc("coordinatesystem").unwrap_or(&e.loc);
+                    return Err(BuildError::at(
+                        loc,
+                        format!("\"coordinatesystem\" must be \"camera\" or \"world\", found \"{other}\""),
+                    ));
+                }
+            };
+            use SurfaceAov::*;
+            let layout = FilmLayout {
+                surface: vec![Albedo, Position, DepthGradient, Normal, ShadingNormal, Uv],
+                variance: true,
+                ..FilmLayout::default()
+            };
+            (layout, FilmKind::GBuffer, space)
+        }
+        "spectral" => {
+            let n = p.get_int("nbuckets", 16)?;
+            let (lo, hi) = (
+                p.get_float("lambdamin", 360.0)?,
+                p.get_float("lambdamax", 830.0)?,
+            );
+            if !(1..=MAX_BUCKETS).contains(&n) {
+                let loc = p.param_loc("nbuckets").unwrap_or(&e.loc);
+                return Err(BuildError::at(
+                    loc,
+                    format!("\"nbuckets\" must be between 1 and {MAX_BUCKETS}, found {n}"),
+                ));
+            }
+            if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lo)
+                || !(LAMBDA_MIN..=LAMBDA_MAX).contains(&hi)
+                || lo >= hi
+            {
+                return Err(BuildError::at(
+                    &e.loc,
+                    format!("\"lambdamin\" {lo} and \"lambdamax\" {hi} must satisfy {LAMBDA_MIN} ≤ lambdamin < lambdamax ≤ {LAMBDA_MAX} nm (the wavelengths candela samples)"),
+                ));
+            }
+            let layout = FilmLayout {
+                spectral: Some(Buckets {
+                    n: n as usize,
+                    lambda_min: lo,
+                    lambda_max: hi,
+                }),
+                ..FilmLayout::default()
+            };
+            (layout, FilmKind::Spectral, SurfaceSpace::World)
+        }
+        other => {
+            return Err(BuildError::at(
+                &e.loc,
+                format!(
+                "film \"{other}\" is not supported (supported: \"rgb\", \"gbuffer\", \"spectral\")"
+            ),
+            ))
+        }
+    };
+    Ok((layout.with_aovs(&ov.aovs), kind, space))
 }
 
 fn camera_exposure(desc: &SceneDescription) -> Result<f32, BuildError> {
@@ -148,10 +198,11 @@ fn pixel_bounds(
         ));
     }
     if let Some(cw) = p.get_floats("cropwindow")? {
-        if cw.len() != 4 || cw[0] >= cw[1] || cw[2] >= cw[3] {
+        let unit = |x: &f32| (0.0..=1.0).contains(x);
+        if cw.len() != 4 || !cw.iter().all(unit) || cw[0] >= cw[1] || cw[2] >= cw[3] {
             return Err(BuildError::at(
                 loc,
-                "\"cropwindow\" must be 4 floats x0 x1 y0 y1 with x0 < x1, y0 < y1",
+                "\"cropwindow\" must be 4 floats x0 x1 y0 y1 in [0, 1] with x0 < x1, y0 < y1",
             ));
         }
         return Ok(crop_bounds([cw[0], cw[1], cw[2], cw[3]], res));
@@ -171,7 +222,7 @@ fn crop_bounds(cw: [f32; 4], res: UVec2) -> (UVec2, UVec2) {
 }
 
 /// The pixel filter (pbrt-v4's default is a Gaussian of radius 1.5, σ 0.5).
-fn filter(desc: &SceneDescription) -> Result<Filter, BuildError> {
+fn filter(desc: &SceneDescription, budget: &mut Budget) -> Result<Filter, BuildError> {
     let Some(e) = &desc.filter else {
         return Ok(Filter::default());
     };
@@ -185,21 +236,33 @@ fn filter(desc: &SceneDescription) -> Result<Filter, BuildError> {
             ),
         )
     })?;
-    let opt = |name: &str| -> Result<Option<f32>, BuildError> {
-        Ok(p.get_floats(name)?.and_then(|v| v.first().copied()))
-    };
-    let (xr, yr) = (opt("xradius")?, opt("yradius")?);
+    let what = format!("PixelFilter \"{}\"", e.name);
+    let ck = Check::new(p, &e.loc, &what);
+    let any = Domain::AtLeast(f32::NEG_INFINITY);
+    let (xr, yr) = (
+        ck.float_opt("xradius", Domain::Positive)?,
+        ck.float_opt("yradius", Domain::Positive)?,
+    );
     let mut fp = FilterParams {
-        sigma: opt("sigma")?,
-        b: opt("B")?,
-        c: opt("C")?,
-        tau: opt("tau")?,
+        sigma: ck.float_opt("sigma", Domain::Positive)?,
+        b: ck.float_opt("B", any)?,
+        c: ck.float_opt("C", any)?,
+        tau: ck.float_opt("tau", Domain::Positive)?,
         ..Default::default()
     };
     if xr.is_some() || yr.is_some() {
-        let def = Filter::new(kind, &FilterParams::default()).radius();
+        let def = Filter::default_radius(kind);
         fp.radius = Some(Vec2::new(xr.unwrap_or(def.x), yr.unwrap_or(def.y)));
     }
+    // The tabulated filters allocate 32² cells per square pixel of radius.
+    let table = Filter::table_bytes(kind, &fp);
+    budget
+        .claim(
+            table,
+            &format!("the {} filter's sampling table", e.name),
+            "lower \"xradius\"/\"yradius\" of the PixelFilter",
+        )
+        .map_err(|m| ck.error(if xr.is_some() { "xradius" } else { "yradius" }, m))?;
     Ok(Filter::new(kind, &fp))
 }
 
@@ -210,19 +273,24 @@ pub fn camera(desc: &SceneDescription, film: &Film) -> Result<Camera, BuildError
         return Camera::perspective(&params).map_err(|e| BuildError::Other(e.to_string()));
     };
     let p = &c.params;
+    let what = format!("Camera \"{}\"", c.name);
+    let ck = Check::new(p, &c.loc, &what);
     let mut params = CameraParams::new(transform(&c.camera_from_world, &c.loc)?, film.resolution());
-    params.lens_radius = p.get_float("lensradius", 0.0)?;
-    params.focal_distance = p.get_float("focaldistance", 1e6)?;
+    params.lens_radius = ck.float("lensradius", 0.0, Domain::NonNegative)?;
+    params.focal_distance = ck.float("focaldistance", 1e6, Domain::Positive)?;
     if let Some(sw) = p.get_floats("screenwindow")? {
-        if sw.len() != 4 {
-            return Err(BuildError::at(&c.loc, "\"screenwindow\" needs 4 values"));
+        if sw.len() != 4 || sw[0] >= sw[1] || sw[2] >= sw[3] {
+            return Err(ck.error(
+                "screenwindow",
+                "needs 4 values x0 x1 y0 y1 with x0 < x1 and y0 < y1",
+            ));
         }
         params.screen_window = Some([sw[0], sw[1], sw[2], sw[3]]);
     }
     params.filter_radius = film.filter().radius();
     let cam = match c.name.as_str() {
         "perspective" => {
-            params.fov_deg = p.get_float("fov", 90.0)?;
+            params.fov_deg = ck.float("fov", 90.0, Domain::Open(0.0, 180.0))?;
             Camera::perspective(&params)
         }
         "orthographic" => Camera::orthographic(&params),
@@ -270,15 +338,19 @@ pub fn sampler(
 ) -> Result<Sampler, BuildError> {
     let empty = super::default_entity("zsobol");
     let e = desc.sampler.as_ref().unwrap_or(&empty);
-    let mut spp = e.params.get_int("pixelsamples", 16)?.max(1) as u32;
+    let what = format!("Sampler \"{}\"", e.name);
+    let ck = Check::new(&e.params, &e.loc, &what);
+    let mut spp = ck.int("pixelsamples", 16, 1)? as u32;
     if e.name == "stratified" {
         // pbrt-v4's stratified sampler takes x/y counts instead of pixelsamples.
-        let (x, y) = (
-            e.params.get_int("xsamples", 4)?,
-            e.params.get_int("ysamples", 4)?,
-        );
+        let (x, y) = (ck.int("xsamples", 4, 1)?, ck.int("ysamples", 4, 1)?);
         let _ = e.params.get_bool("jitter", true)?;
-        spp = (x * y).max(1) as u32;
+        spp = (x as u32).checked_mul(y as u32).ok_or_else(|| {
+            ck.error(
+                "ysamples",
+                format!("times \"xsamples\" ({x}) overflows the sample count"),
+            )
+        })?;
     }
     let spp = ov.spp.unwrap_or(spp);
     let seed = match ov.seed {

@@ -4,6 +4,7 @@
 //! (or that belongs to a moving instance) is built in object space and
 //! placed in a [`MovingGroup`] with its [`AnimatedTransform`].
 
+use super::budget::Budget;
 use super::lights::area_light_spec;
 use super::materials::MaterialNames;
 use super::shapes::build_shape;
@@ -11,8 +12,9 @@ use super::textures::{Source, Textures};
 use super::BuildError;
 use crate::interaction::{LightId, MaterialId};
 use crate::light::Light;
-use crate::math::{AnimatedTransform, Transform};
+use crate::math::{AnimatedTransform, Bounds3, Transform};
 use crate::scene::{MovingGroup, Primitive};
+use crate::shape::Shape;
 use crate::texture::FloatTexture;
 use candela_scene::{MaterialRef, SceneDescription, ShapeDesc};
 
@@ -37,11 +39,12 @@ struct Placement {
     times: [f32; 2],
 }
 
-/// Shapes being collected.
-struct Sink {
+/// Shapes being collected, and the memory budget refined meshes claim.
+struct Sink<'a> {
     prims: Vec<Primitive>,
     movers: Vec<MovingGroup>,
     lights: Vec<Light>,
+    budget: &'a mut Budget,
 }
 
 fn transform(
@@ -59,12 +62,14 @@ fn transform(
 pub fn primitives(
     desc: &SceneDescription,
     names: &MaterialNames,
+    budget: &mut Budget,
     warnings: &mut Vec<String>,
 ) -> Result<Built, BuildError> {
     let mut sink = Sink {
         prims: Vec::new(),
         movers: Vec::new(),
         lights: Vec::new(),
+        budget,
     };
     let mut tex = Textures::new(&desc.textures);
     let tex = &mut tex;
@@ -117,21 +122,26 @@ pub fn primitives(
     })
 }
 
+/// The material a shape refers to (named ones must be defined).
+fn material_of(s: &ShapeDesc, names: &MaterialNames) -> Result<MaterialId, BuildError> {
+    Ok(match &s.material {
+        MaterialRef::Index(i) => MaterialId(*i as u32),
+        MaterialRef::Named(n) => *names.0.get(n).ok_or_else(|| {
+            BuildError::at(&s.loc, format!("named material \"{n}\" is not defined"))
+        })?,
+        MaterialRef::None => names.1,
+    })
+}
+
 fn add_shape(
     s: &ShapeDesc,
     parent: &Placement,
     names: &MaterialNames,
     tex: &mut Textures,
-    sink: &mut Sink,
+    sink: &mut Sink<'_>,
     warnings: &mut Vec<String>,
 ) -> Result<(), BuildError> {
-    let material = match &s.material {
-        MaterialRef::Index(i) => Some(MaterialId(*i as u32)),
-        MaterialRef::Named(n) => Some(*names.0.get(n).ok_or_else(|| {
-            BuildError::at(&s.loc, format!("named material \"{n}\" is not defined"))
-        })?),
-        MaterialRef::None => Some(names.1),
-    };
+    let material = Some(material_of(s, names)?);
     let Some(object) = Transform::from_rows_f64(s.render_from_object.m) else {
         warnings.push(singular(&s.loc, "shape"));
         s.params.mark_all_used();
@@ -156,7 +166,8 @@ fn add_shape(
             AnimatedTransform::new(render_from_object, parent.times[0], end, parent.times[1]);
         return add_moving_shape(s, material, alpha, motion, sink);
     }
-    let shapes = build_shape(s, &render_from_object)?;
+    let shapes = build_shape(s, &render_from_object, sink.budget)?;
+    finite_bounds(s, shapes.iter().map(Shape::bounds))?;
     let spec = s
         .area_light
         .as_ref()
@@ -205,7 +216,7 @@ fn add_moving_shape(
     material: Option<MaterialId>,
     alpha: Alpha,
     motion: AnimatedTransform,
-    sink: &mut Sink,
+    sink: &mut Sink<'_>,
 ) -> Result<(), BuildError> {
     if let Some(a) = &s.area_light {
         return Err(BuildError::at(
@@ -216,7 +227,12 @@ fn add_moving_shape(
     let Alpha::Mask(alpha) = alpha else {
         return Ok(()); // Switched off (only emitters, refused above).
     };
-    let prims = build_shape(s, &Transform::IDENTITY)?
+    let shapes = build_shape(s, &Transform::IDENTITY, sink.budget)?;
+    finite_bounds(
+        s,
+        shapes.iter().map(|sh| motion.motion_bounds(&sh.bounds())),
+    )?;
+    let prims = shapes
         .into_iter()
         .map(|shape| Primitive {
             shape,
@@ -227,6 +243,28 @@ fn add_moving_shape(
         .collect();
     sink.movers.push(MovingGroup::new(prims, motion));
     Ok(())
+}
+
+/// Fails unless every one of `bounds` (a shape's pieces in render space) is
+/// finite: a transform or vertex that overflows single precision would
+/// otherwise reach the BVH.
+fn finite_bounds(
+    s: &ShapeDesc,
+    mut bounds: impl Iterator<Item = Bounds3>,
+) -> Result<(), BuildError> {
+    let finite = |b: &Bounds3| b.min.is_finite() && b.max.is_finite();
+    match bounds.find(|b| !finite(b)) {
+        None => Ok(()),
+        Some(b) => Err(BuildError::at(
+            &s.loc,
+            format!(
+                "Shape \"{}\" has non-finite bounds in render space ({:?} to {:?}): its size and transformation overflow single precision",
+                s.name,
+                b.min.to_array(),
+                b.max.to_array()
+            ),
+        )),
+    }
 }
 
 /// The warning for an entity left out because its CTM is singular (pbrt-v4

@@ -1,7 +1,15 @@
 //! `Integrator` directives → integrators: one settings reader per
 //! integrator, with pbrt-v4's parameter names and defaults (candela's own
 //! integrators document theirs in their modules).
+//!
+//! Building is in two steps: [`integrator`] reads and checks every parameter
+//! before the scene is built; [`finish`] then gives the photon integrators
+//! their default radius (which depends on the scene, see
+//! [`super::photon_scale`]) and claims their memory.
 
+use super::budget::Budget;
+use super::check::{Check, Domain};
+use super::photon_scale::{self, SceneScale};
 use super::{BuildError, Overrides};
 use crate::integrator::photonmap::Kernel;
 use crate::integrator::{
@@ -11,10 +19,25 @@ use crate::integrator::{
 };
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription};
 
-/// The integrator a scene asks for (or `--integrator`), built.
-pub struct BuiltIntegrator {
-    /// The integrator.
-    pub integrator: Box<dyn Integrator>,
+/// The settings of each integrator, read and checked.
+enum Settings {
+    Path(PathSettings),
+    LightPath(LightTracerSettings),
+    Bdpt(BdptSettings),
+    Sppm(SppmSettings),
+    Ppm(PpmSettings),
+    PhotonMap(PhotonMapSettings),
+}
+
+/// The integrator a scene asks for (or `--integrator`), read and checked
+/// but not yet given its scene-dependent defaults.
+pub struct Planned<'a> {
+    kind: IntegratorKind,
+    settings: Settings,
+    /// The directive (or pbrt-v4's default).
+    entity: &'a Entity,
+    /// `"float radius"` as written (SPPM and PPM).
+    radius: Option<f32>,
     /// Lights are chosen in proportion to power (else uniformly).
     pub power_sampling: bool,
     /// BDPT strategy layers the film must record (0 without visualisation).
@@ -40,14 +63,14 @@ pub fn kind_from_name(name: &str) -> Option<(IntegratorKind, bool)> {
 /// Names accepted by [`kind_from_name`].
 pub const INTEGRATOR_NAMES: &str = "path, volpath, lightpath, bdpt, sppm, ppm, photonmap";
 
-/// Builds the integrator of `desc` (or of `--integrator`).
-pub fn integrator(
-    desc: &SceneDescription,
+/// Reads and checks the integrator of `desc` (or of `--integrator`).
+pub fn integrator<'a>(
+    desc: &'a SceneDescription,
     ov: &Overrides,
+    default: &'a Entity,
     warnings: &mut Vec<String>,
-) -> Result<BuiltIntegrator, BuildError> {
-    let empty = super::default_entity("volpath");
-    let e = desc.integrator.as_ref().unwrap_or(&empty);
+) -> Result<Planned<'a>, BuildError> {
+    let e = desc.integrator.as_ref().unwrap_or(default);
     let (name, from_flag) = match &ov.integrator {
         Some(n) => (n.as_str(), true),
         None => (e.name.as_str(), false),
@@ -67,83 +90,141 @@ pub fn integrator(
         ));
     }
     let p = &e.params;
+    let what = format!("Integrator \"{}\"", e.name);
+    let ck = Check::new(p, &e.loc, &what);
     let power_sampling = light_sampler(p, &e.loc)?;
     let seed = render_seed(desc, ov)?;
     let common = Common {
-        max_depth: p.get_int("maxdepth", 5)?.max(0) as u32,
+        max_depth: ck.int("maxdepth", 5, 0)? as u32,
         regularize: p.get_bool("regularize", false)?,
         seed,
         flag_seed: ov.seed,
     };
-    let (integrator, strategy_layers) = construct(kind, e, &common, power_sampling, warnings)?;
+    let (settings, strategy_layers) = construct(kind, &ck, &common, power_sampling, warnings)?;
+    let radius = match kind {
+        IntegratorKind::Sppm | IntegratorKind::Ppm => ck.float_opt("radius", Domain::Positive)?,
+        _ => None,
+    };
     // Photons are shot by power, as pbrt-v4's SPPM does.
     let power_sampling = power_sampling
         || matches!(
             kind,
             IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::PhotonMap
         );
-    Ok(BuiltIntegrator {
-        integrator,
+    Ok(Planned {
+        kind,
+        settings,
+        entity: e,
+        radius,
         power_sampling,
         strategy_layers,
     })
 }
 
-/// The integrator of `kind` from the directive `e`, and the BDPT strategy
+impl Planned<'_> {
+    /// The estimator that will run.
+    pub fn kind(&self) -> IntegratorKind {
+        self.kind
+    }
+}
+
+/// The integrator of `plan` in the built scene: SPPM and PPM get their
+/// default radius when the file gives none, and the photon integrators'
+/// structures are claimed against `budget`.
+pub fn finish(
+    plan: Planned<'_>,
+    scale: &SceneScale,
+    budget: &mut Budget,
+    warnings: &mut Vec<String>,
+) -> Result<Box<dyn Integrator>, BuildError> {
+    let e = plan.entity;
+    let what = format!("Integrator \"{}\"", e.name);
+    let ck = Check::new(&e.params, &e.loc, &what);
+    let radius = |warnings: &mut Vec<String>| match plan.radius {
+        Some(r) => {
+            warnings.extend(photon_scale::radius_warning(
+                ck.loc_of("radius"),
+                &e.name,
+                r,
+                scale,
+            ));
+            r
+        }
+        None => scale.default_radius(),
+    };
+    Ok(match plan.settings {
+        Settings::Path(settings) => Box::new(PathIntegrator { settings }),
+        Settings::LightPath(settings) => Box::new(LightTracer { settings }),
+        Settings::Bdpt(settings) => Box::new(BdptIntegrator { settings }),
+        Settings::Sppm(mut settings) => {
+            settings.radius = radius(warnings);
+            let photons = photon_scale::photons(settings.photons_per_iteration, scale);
+            photon_scale::claim_progressive(
+                &ck,
+                settings.radius,
+                photons,
+                scale,
+                budget,
+                warnings,
+            )?;
+            Box::new(SppmIntegrator { settings })
+        }
+        Settings::Ppm(mut settings) => {
+            settings.radius = radius(warnings);
+            let photons = photon_scale::photons(settings.photons_per_pass, scale);
+            photon_scale::claim_progressive(
+                &ck,
+                settings.radius,
+                photons,
+                scale,
+                budget,
+                warnings,
+            )?;
+            Box::new(PpmIntegrator { settings })
+        }
+        Settings::PhotonMap(settings) => {
+            photon_scale::claim_photon_map(&ck, &settings, budget)?;
+            Box::new(PhotonMapIntegrator { settings })
+        }
+    })
+}
+
+/// The settings of `kind` from the directive `ck`, and the BDPT strategy
 /// layers it needs.
 fn construct(
     kind: IntegratorKind,
-    e: &Entity,
+    ck: &Check<'_>,
     common: &Common,
     power_sampling: bool,
     warnings: &mut Vec<String>,
-) -> Result<(Box<dyn Integrator>, usize), BuildError> {
-    let p = &e.params;
+) -> Result<(Settings, usize), BuildError> {
     Ok(match kind {
-        IntegratorKind::Path => (
-            Box::new(PathIntegrator {
-                settings: path_settings(common),
-            }),
-            0,
-        ),
+        IntegratorKind::Path => (Settings::Path(path_settings(common)), 0),
         IntegratorKind::LightPath => (
-            Box::new(LightTracer {
-                settings: LightTracerSettings {
-                    max_depth: common.max_depth,
-                    seed: common.seed,
-                },
+            Settings::LightPath(LightTracerSettings {
+                max_depth: common.max_depth,
+                seed: common.seed,
             }),
             0,
         ),
         IntegratorKind::Bdpt => {
-            let settings = bdpt_settings(p, common)?;
+            let settings = bdpt_settings(ck, common)?;
             let layers = match settings.visualize {
                 Some(_) => Visualize::strategy_count(settings.max_depth),
                 None => 0,
             };
-            (Box::new(BdptIntegrator { settings }), layers)
+            (Settings::Bdpt(settings), layers)
         }
-        IntegratorKind::Sppm => (
-            Box::new(SppmIntegrator {
-                settings: sppm_settings(e, common)?,
-            }),
-            0,
-        ),
-        IntegratorKind::Ppm => (
-            Box::new(PpmIntegrator {
-                settings: ppm_settings(e, common)?,
-            }),
-            0,
-        ),
+        IntegratorKind::Sppm => (Settings::Sppm(sppm_settings(ck, common)?), 0),
+        IntegratorKind::Ppm => (Settings::Ppm(ppm_settings(ck, common)?), 0),
         IntegratorKind::PhotonMap => {
             if !power_sampling {
                 warnings.push(format!(
                     "{}: \"photonmap\" always chooses lights by power; \"lightsampler\" is ignored",
-                    e.loc
+                    ck.loc
                 ));
             }
-            let settings = photonmap_settings(p, common, &e.loc)?;
-            (Box::new(PhotonMapIntegrator { settings }), 0)
+            (Settings::PhotonMap(photonmap_settings(ck, common)?), 0)
         }
     })
 }
@@ -187,9 +268,22 @@ fn path_settings(c: &Common) -> PathSettings {
     }
 }
 
-fn bdpt_settings(p: &ParamSet, c: &Common) -> Result<BdptSettings, BuildError> {
+/// Deepest `maxdepth` whose strategies BDPT can write as images.
+const MAX_VISUALIZED_DEPTH: u32 = 63;
+
+fn bdpt_settings(ck: &Check<'_>, c: &Common) -> Result<BdptSettings, BuildError> {
+    let p = ck.params;
     let strategies = p.get_bool("visualizestrategies", false)?;
     let weights = p.get_bool("visualizeweights", false)?;
+    if (strategies || weights) && c.max_depth > MAX_VISUALIZED_DEPTH {
+        return Err(ck.error(
+            "maxdepth",
+            format!(
+                "must be at most {MAX_VISUALIZED_DEPTH} to visualize strategies (one image per strategy), found {}",
+                c.max_depth
+            ),
+        ));
+    }
     Ok(BdptSettings {
         max_depth: c.max_depth,
         regularize: c.regularize,
@@ -198,87 +292,68 @@ fn bdpt_settings(p: &ParamSet, c: &Common) -> Result<BdptSettings, BuildError> {
     })
 }
 
-/// `"float radius"` of the photon integrators (pbrt-v4's default 1).
-fn photon_radius(e: &Entity) -> Result<f32, BuildError> {
-    let p = &e.params;
-    let radius = p.get_float("radius", 1.0)?;
-    if radius.is_nan() || radius <= 0.0 || radius.is_infinite() {
-        return Err(BuildError::at(
-            p.param_loc("radius").unwrap_or(&e.loc),
-            format!("\"radius\" must be a positive finite number, found {radius}"),
-        ));
-    }
-    Ok(radius)
-}
-
 /// `"integer seed"` of SPPM/PPM (pbrt-v4's): `--seed`, else the integrator's own.
-fn photon_seed(e: &Entity, c: &Common) -> Result<u64, BuildError> {
+fn photon_seed(ck: &Check<'_>, c: &Common) -> Result<u64, BuildError> {
     Ok(match c.flag_seed {
         Some(s) => s,
-        None => e.params.get_int("seed", 0)? as u64,
+        None => ck.params.get_int("seed", 0)? as u64,
     })
 }
 
-fn sppm_settings(e: &Entity, c: &Common) -> Result<SppmSettings, BuildError> {
+/// `"integer photonsperiteration"`: positive, or −1 (pbrt-v4's default: one
+/// photon per pixel; any value ≤ 0 means that, as in pbrt-v4).
+fn photons_per_iteration(ck: &Check<'_>) -> Result<i64, BuildError> {
+    Ok(ck.params.get_int("photonsperiteration", -1)? as i64)
+}
+
+/// SPPM's settings; the radius is set by [`finish`].
+fn sppm_settings(ck: &Check<'_>, c: &Common) -> Result<SppmSettings, BuildError> {
     Ok(SppmSettings {
-        photons_per_iteration: e.params.get_int("photonsperiteration", -1)? as i64,
-        radius: photon_radius(e)?,
+        photons_per_iteration: photons_per_iteration(ck)?,
+        radius: 1.0,
         max_depth: c.max_depth,
-        seed: photon_seed(e, c)?,
+        seed: photon_seed(ck, c)?,
     })
 }
 
-fn ppm_settings(e: &Entity, c: &Common) -> Result<PpmSettings, BuildError> {
+/// PPM's settings; the radius is set by [`finish`].
+fn ppm_settings(ck: &Check<'_>, c: &Common) -> Result<PpmSettings, BuildError> {
     Ok(PpmSettings {
-        photons_per_pass: e.params.get_int("photonsperiteration", -1)? as i64,
-        radius: photon_radius(e)?,
+        photons_per_pass: photons_per_iteration(ck)?,
+        radius: 1.0,
         max_depth: c.max_depth,
-        seed: photon_seed(e, c)?,
+        seed: photon_seed(ck, c)?,
     })
 }
 
 /// `Integrator "photonmap"` parameters (table in `integrator::photonmap`).
-fn photonmap_settings(
-    p: &ParamSet,
-    c: &Common,
-    loc: &Loc,
-) -> Result<PhotonMapSettings, BuildError> {
+fn photonmap_settings(ck: &Check<'_>, c: &Common) -> Result<PhotonMapSettings, BuildError> {
+    let p = ck.params;
     let d = PhotonMapSettings::default();
-    let count = |name: &str, def: u64| -> Result<u64, BuildError> {
-        Ok(p.get_int(name, def as i32)?.max(0) as u64)
+    let count = |name: &str, def: u64, min: i32| -> Result<u64, BuildError> {
+        Ok(ck.int(name, def as i32, min)? as u64)
     };
     let kernel = match p.get_string("kernel", "cone")?.as_str() {
-        "cone" => match p.get_float("conek", 1.1)? {
-            k if k >= 1.0 => Kernel::Cone(k),
-            _ => return Err(BuildError::at(loc, "\"conek\" must be at least 1")),
-        },
+        "cone" => Kernel::Cone(ck.float("conek", 1.1, Domain::AtLeast(1.0))?),
         "epanechnikov" => Kernel::Epanechnikov,
         "disk" => Kernel::Disk,
         other => {
-            return Err(BuildError::at(
-                loc,
-                format!("unknown kernel \"{other}\" (known: cone, epanechnikov, disk)"),
+            return Err(ck.error(
+                "kernel",
+                format!("\"{other}\" is unknown (known: cone, epanechnikov, disk)"),
             ))
         }
     };
-    let radius = |name: &str| match p.get_floats(name)? {
-        None => Ok(None),
-        Some(v) if v.len() == 1 && v[0] > 0.0 => Ok(Some(v[0])),
-        Some(_) => Err(BuildError::at(
-            loc,
-            format!("\"{name}\" must be one positive float"),
-        )),
-    };
     Ok(PhotonMapSettings {
         max_depth: c.max_depth,
-        photons: count("photons", d.photons)?,
-        caustic_photons: count("causticphotons", d.caustic_photons)?,
-        lookup: count("lookup", d.lookup as u64)?.max(2) as usize,
-        max_radius: radius("maxradius")?,
-        caustic_max_radius: radius("causticmaxradius")?,
+        photons: count("photons", d.photons, 0)?,
+        caustic_photons: count("causticphotons", d.caustic_photons, 0)?,
+        lookup: count("lookup", d.lookup as u64, 2)? as usize,
+        max_radius: ck.float_opt("maxradius", Domain::Positive)?,
+        caustic_max_radius: ck.float_opt("causticmaxradius", Domain::Positive)?,
         kernel,
         final_gather: p.get_bool("finalgather", d.final_gather)?,
-        gather_rays: count("gatherrays", d.gather_rays as u64)? as u32,
+        gather_rays: count("gatherrays", d.gather_rays as u64, 1)? as u32,
         seed: c.seed,
     })
 }

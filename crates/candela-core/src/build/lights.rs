@@ -22,7 +22,13 @@
 //! goniometric map must be square, the projector's image RGB, and neither
 //! may hold infinite or NaN texels. A projector's `fov` must lie in
 //! (0°, 180°).
+//!
+//! Every light's `scale` is ≥ 0 (a negative one would emit negative
+//! radiance); a spot light's `coneangle` lies in (0°, 180°] and its
+//! `conedeltaangle` in [0°, `coneangle`]. A `power` or `illuminance` ≤ 0
+//! means "not given", as in pbrt-v4.
 
+use super::check::{Check, Domain};
 use super::spectra::{spectrum_param, SpectrumKind};
 use super::BuildError;
 use crate::image::{read_map, ColorEncoding, MapImage};
@@ -123,10 +129,12 @@ pub fn area_light_spec(
         }
         (None, l) => AreaEmission::Spectrum(l.unwrap_or_else(|| scene_cs.illuminant.clone())),
     };
+    let what = format!("AreaLightSource \"{}\"", a.name);
+    let ck = Check::new(p, &a.loc, &what);
     Ok(AreaLightSpec {
         emission,
         scene_cs,
-        scale: p.get_float("scale", 1.0)?,
+        scale: ck.float("scale", 1.0, Domain::NonNegative)?,
         two_sided: p.get_bool("twosided", false)?,
         power: optional_positive(p.get_float("power", -1.0)?),
     })
@@ -149,18 +157,31 @@ fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError>
         Ok(spectrum_param(p, name, SpectrumKind::Illuminant, space)?
             .unwrap_or_else(|| space.illuminant.clone()))
     };
-    let scale = p.get_float("scale", 1.0)?;
+    let what = format!("LightSource \"{}\"", d.name);
+    let ck = Check::new(p, &d.loc, &what);
+    let scale = ck.float("scale", 1.0, Domain::NonNegative)?;
     let v3 = |name: &str, def: Vec3| -> Result<Vec3, BuildError> {
         Ok(p.get_point3(name, def.to_array())?.into())
     };
+    if matches!(d.name.as_str(), "spot" | "distant")
+        && v3("from", Vec3::ZERO)? == v3("to", Vec3::Z)?
+    {
+        return Err(ck.error(
+            "to",
+            "must differ from \"from\": together they give the light's direction",
+        ));
+    }
     Ok(match d.name.as_str() {
         "point" => Light::Point(create::point_light(&t, illum("I")?, scale, optional_positive(p.get_float("power", -1.0)?), v3("from", Vec3::ZERO)?)),
         "spot" => Light::Spot(create::spot_light(
             &t,
             illum("I")?,
             scale,
-            p.get_float("coneangle", 30.0)?,
-            p.get_float("conedeltaangle", 5.0)?,
+            ck.float("coneangle", 30.0, Domain::LeftOpen(0.0, 180.0))?,
+            {
+                let cone = p.get_float("coneangle", 30.0)?;
+                ck.float("conedeltaangle", 5.0, Domain::Closed(0.0, cone))?
+            },
             optional_positive(p.get_float("power", -1.0)?),
             v3("from", Vec3::ZERO)?,
             v3("to", Vec3::Z)?,

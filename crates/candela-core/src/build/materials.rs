@@ -6,7 +6,8 @@
 //! built (anonymous materials first, then named ones in declaration
 //! order), and mixes that contain themselves are rejected.
 
-use super::coated::{coated_conductor, coated_diffuse, conductor_spec, eta_param};
+use super::check::Domain;
+use super::coated::{coated_conductor, coated_diffuse, conductor_spec, constant_in, eta_param};
 use super::spectra::SpectrumKind;
 use super::textures::{Source, Textures};
 use super::BuildError;
@@ -62,6 +63,15 @@ fn roughness(src: &Source, tex: &mut Textures) -> Result<Roughness, BuildError> 
         (Some(_), Some(_)) => FloatTexture::Constant(0.0),
         _ => tex.float(src, "roughness", 0.0)?,
     };
+    for (name, t) in [
+        ("uroughness", &u),
+        ("vroughness", &v),
+        ("roughness", &Some(common.clone())),
+    ] {
+        if let Some(t) = t {
+            constant_in(src, name, t, Domain::NonNegative)?;
+        }
+    }
     Ok(Roughness {
         u: u.unwrap_or_else(|| common.clone()),
         v: v.unwrap_or(common),
@@ -117,7 +127,11 @@ fn material(
         "diffusetransmission" => Material::DiffuseTransmission {
             reflectance: tex.spectrum(&src, "reflectance", SpectrumKind::Albedo, 0.25)?,
             transmittance: tex.spectrum(&src, "transmittance", SpectrumKind::Albedo, 0.25)?,
-            scale: src.params.get_float("scale", 1.0)?,
+            scale: super::check::Check::new(src.params, src.loc, "Material").float(
+                "scale",
+                1.0,
+                Domain::NonNegative,
+            )?,
             bump,
         },
         "coateddiffuse" => coated_diffuse(&src, tex, bump)?,
@@ -153,9 +167,11 @@ fn mix(
             )
         })
     };
+    let amount = tex.float(src, "amount", 0.5)?;
+    constant_in(src, "amount", &amount, Domain::Closed(0.0, 1.0))?;
     Ok(Material::Mix {
         materials: [id(a)?, id(b)?],
-        amount: tex.float(src, "amount", 0.5)?,
+        amount,
     })
 }
 

@@ -3,8 +3,13 @@
 //! with pbrt-v4's parameter names and defaults.
 //!
 //! Everything not supported is an error naming the entity and its
-//! file:line:col; parameters nobody looked at become warnings.
+//! file:line:col; parameters nobody looked at become warnings. Every
+//! parameter is checked against its domain ([`check`]) and the large
+//! structures against a memory budget ([`budget`]) before they are
+//! allocated.
 
+pub mod budget;
+mod check;
 mod coated;
 mod entities;
 mod geometry;
@@ -12,16 +17,19 @@ mod image_textures;
 mod integrators;
 mod lights;
 mod materials;
+mod photon_scale;
 mod shapes;
 mod spectra;
 mod summary;
 mod textures;
 
+pub use budget::parse_memory;
 pub use integrators::{kind_from_name, INTEGRATOR_NAMES};
+pub use photon_scale::{FALLBACK_SHARE, FOOTPRINT_PIXELS};
 pub use summary::{summarize, Counts, SceneSummary};
 
 use crate::camera::{Camera, PixelFootprint};
-use crate::film::{Film, FilmKind, FilmLayout, SurfaceSpace};
+use crate::film::{Film, FilmLayout};
 use crate::integrator::{Integrator, IntegratorKind};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -82,6 +90,12 @@ pub struct Overrides {
     /// `--cropwindow x0,x1,y0,y1` (pbrt-v4's; replaces the film's
     /// `cropwindow` and `pixelbounds`).
     pub cropwindow: Option<[f32; 4]>,
+    /// `--aov`: extra film layers.
+    pub aovs: Vec<crate::film::Aov>,
+    /// `--memory-limit` in bytes (default: [`budget::DEFAULT_SHARE`] of
+    /// physical memory). Not part of a render's identity: it only decides
+    /// whether the render may start.
+    pub memory_limit: Option<u64>,
 }
 
 /// Everything needed to render.
@@ -100,30 +114,27 @@ pub struct RenderSetup {
     pub outfile: PathBuf,
     /// Non-fatal problems (unused parameters, substitutions).
     pub warnings: Vec<String>,
+    /// The estimated memory of the render's large structures.
+    pub budget: budget::Budget,
 }
 
 /// Builds the render setup.
 pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, BuildError> {
+    check::finite_scene(desc)?;
+    let mut budget = budget::Budget::new(ov.memory_limit);
     let mut warnings: Vec<String> = desc
         .warnings
         .iter()
         .map(|w| format!("{}: {}", w.loc, w.message))
         .collect();
-    let (film, outfile) = entities::film(desc, ov, &mut warnings)?;
+    let (film, outfile) = entities::film(desc, ov, &mut budget)?;
     let camera = entities::camera(desc, &film)?;
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
-    let built = integrators::integrator(desc, ov, &mut warnings)?;
-    let (integrator, power_sampling) = (built.integrator, built.power_sampling);
-    let film = if built.strategy_layers > 0 {
-        let layout = FilmLayout {
-            strategies: built.strategy_layers,
-            ..film.layout().clone()
-        };
-        film.with_layers(layout, FilmKind::Rgb, SurfaceSpace::World)
-    } else {
-        film
-    };
-    let kind = integrator.kind();
+    let default_integrator = default_entity("volpath");
+    let plan = integrators::integrator(desc, ov, &default_integrator, &mut warnings)?;
+    let film = with_strategy_layers(film, plan.strategy_layers);
+    claim_film(desc, &film, &mut budget)?;
+    let kind = plan.kind();
     if kind == IntegratorKind::LightPath && !camera.is_connectable() {
         return Err(BuildError::Other(
             "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
@@ -135,7 +146,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         movers,
         mut lights,
         textures_used: alpha_used,
-    } = geometry::primitives(desc, &names, &mut warnings)?;
+    } = geometry::primitives(desc, &names, &mut budget, &mut warnings)?;
     let textures_used: Vec<bool> = textures_used
         .iter()
         .zip(&alpha_used)
@@ -143,6 +154,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .collect();
     lights.extend(lights::lights(desc, &mut warnings)?);
     let shutter = entities::shutter(desc)?;
+    let power_sampling = plan.power_sampling;
     let mut scene = Scene::with_motion(prims, movers, shutter, materials, lights, power_sampling);
     // Only textures read the differentials (filter widths, bump steps), and
     // every non-constant texture is a `Texture` directive: without any, the
@@ -155,9 +167,18 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
             sampler.samples_per_pixel(),
         )));
     }
-    if let Some(w) = photon_radius_warning(desc, kind, &scene)? {
-        warnings.push(w);
-    }
+    let integrator = match kind {
+        IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::PhotonMap => {
+            let scale = photon_scale::SceneScale::measure(&scene, &camera, &film);
+            integrators::finish(plan, &scale, &mut budget, &mut warnings)?
+        }
+        _ => integrators::finish(
+            plan,
+            &photon_scale::SceneScale::none(),
+            &mut budget,
+            &mut warnings,
+        )?,
+    };
     collect_unused(desc, &textures_used, &mut warnings);
     Ok(RenderSetup {
         scene,
@@ -167,42 +188,46 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         integrator,
         outfile,
         warnings,
+        budget,
     })
 }
 
-/// SPPM/PPM start from one gather radius for the whole scene; pbrt-v4's default
-/// of 1 is huge for a scene a few units wide (every photon lands in every
-/// visible point's disk: blurry and slow) and tiny for one kilometres wide.
-/// Warn when the radius is far from the scene's scale.
-fn photon_radius_warning(
-    desc: &SceneDescription,
-    kind: IntegratorKind,
-    scene: &Scene,
-) -> Result<Option<String>, BuildError> {
-    let (Some(e), IntegratorKind::Sppm | IntegratorKind::Ppm) = (&desc.integrator, kind) else {
-        return Ok(None);
-    };
-    let integrator = kind.name();
-    let radius = e.params.get_float("radius", 1.0)?;
-    let b = scene.bounds();
-    let diagonal = (b.max - b.min).length();
-    if !diagonal.is_finite() || diagonal <= 0.0 {
-        return Ok(None);
+/// The film with `n` strategy layers added (BDPT's visualisation).
+fn with_strategy_layers(film: Film, n: usize) -> Film {
+    if n == 0 {
+        return film;
     }
-    let share = radius / diagonal;
-    let loc = e.params.param_loc("radius").unwrap_or(&e.loc);
-    Ok(if share > 0.05 {
-        Some(format!(
-            "{loc}: {integrator} \"radius\" {radius} is {:.0}% of the scene's diagonal ({diagonal:.3}): expect blur and slow early passes; set \"float radius\" to about 1% of it",
-            share * 100.0
-        ))
-    } else if share < 1e-5 {
-        Some(format!(
-            "{loc}: {integrator} \"radius\" {radius} is tiny against the scene's diagonal ({diagonal:.3}): visible points will gather almost no photons"
-        ))
-    } else {
-        None
-    })
+    let layout = FilmLayout {
+        strategies: n,
+        ..film.layout().clone()
+    };
+    let (kind, space) = (film.kind(), film.surface_space());
+    film.with_layers(layout, kind, space)
+}
+
+/// Claims the film's memory; past the limit, the error is at the Film
+/// directive and names its resolution.
+fn claim_film(
+    desc: &SceneDescription,
+    film: &Film,
+    budget: &mut budget::Budget,
+) -> Result<(), BuildError> {
+    let (lo, hi) = film.pixel_bounds();
+    let what = format!(
+        "the film ({}×{} pixels of {}×{}, {} channels a pixel)",
+        hi.x - lo.x,
+        hi.y - lo.y,
+        film.resolution().x,
+        film.resolution().y,
+        film.layout().state_stride()
+    );
+    let fix = "lower \"xresolution\"/\"yresolution\" of the Film or crop it";
+    budget
+        .claim(photon_scale::film_bytes(film), &what, fix)
+        .map_err(|m| match &desc.film {
+            Some(e) => BuildError::at(&e.loc, format!("Film \"{}\" {m}", e.name)),
+            None => BuildError::Other(m),
+        })
 }
 
 fn unused_of(params: &ParamSet, what: &str, warnings: &mut Vec<String>) {

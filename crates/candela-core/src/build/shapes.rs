@@ -12,44 +12,67 @@
 //! | `loopsubdiv` | `levels` (3), `indices`, `P`; `scheme` is read and ignored, as pbrt-v4 does |
 //!
 //! Parameters no shape reads are reported as unused by the caller.
+//!
+//! Domains: every radius is positive; `phimax` lies in (0°, 360°]; a disk's
+//! `innerradius` in [0, `radius`); a quadric's z range must keep some surface
+//! (pbrt-v4 clamps `zmin`/`zmax` to the sphere, and so does candela, but an
+//! empty range is an error); `levels` of a subdivision surface in 0‥
+//! [`MAX_LOOP_LEVELS`], and the refined mesh is claimed against the memory
+//! budget. Vertex data are finite (checked for the whole scene first).
 
+use super::budget::Budget;
+use super::check::{Check, Domain};
 use super::BuildError;
 use crate::math::{Transform, Vec2, Vec3};
 use crate::shape::{
     loop_subdivide, BilinearPatch, BilinearPatchMesh, Cylinder, Disk, Shape, Sphere, Triangle,
     TriangleMesh,
 };
-use candela_scene::{ParamSet, SceneError, ShapeDesc};
+use candela_scene::{SceneError, ShapeDesc};
 use std::sync::Arc;
 
+/// Deepest Loop subdivision (each level makes four triangles of one; 12
+/// levels turn one triangle into 16.7 M).
+pub const MAX_LOOP_LEVELS: i32 = 12;
+
 /// The shapes one `Shape` directive creates, placed by `t`.
-pub fn build_shape(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
+pub fn build_shape(
+    s: &ShapeDesc,
+    t: &Transform,
+    budget: &mut Budget,
+) -> Result<Vec<Shape>, BuildError> {
     let p = &s.params;
+    let what = format!("Shape \"{}\"", s.name);
+    let ck = Check::new(p, &s.loc, &what);
     let (ro, tt) = (s.reverse_orientation, Arc::new(*t));
     Ok(match s.name.as_str() {
         "sphere" => {
-            let r = p.get_float("radius", 1.0)?;
-            let (zmin, zmax, phimax) = quadric_range(p, -r, r)?;
+            let r = ck.float("radius", 1.0, Domain::Positive)?;
+            let (zmin, zmax, phimax) = quadric_range(&ck, -r, r, Some(r))?;
             vec![Shape::Sphere(Sphere::new(tt, ro, r, zmin, zmax, phimax))]
         }
         "cylinder" => {
-            let r = p.get_float("radius", 1.0)?;
-            let (zmin, zmax, phimax) = quadric_range(p, -1.0, 1.0)?;
+            let r = ck.float("radius", 1.0, Domain::Positive)?;
+            let (zmin, zmax, phimax) = quadric_range(&ck, -1.0, 1.0, None)?;
             vec![Shape::Cylinder(Cylinder::new(tt, ro, r, zmin, zmax, phimax))]
         }
         "disk" => {
-            let (h, r, ri, phimax) = (
-                p.get_float("height", 0.0)?,
-                p.get_float("radius", 1.0)?,
-                p.get_float("innerradius", 0.0)?,
-                p.get_float("phimax", 360.0)?,
-            );
+            let h = p.get_float("height", 0.0)?;
+            let r = ck.float("radius", 1.0, Domain::Positive)?;
+            let ri = p.get_float("innerradius", 0.0)?;
+            if !(0.0..r).contains(&ri) {
+                return Err(ck.error(
+                    "innerradius",
+                    format!("must lie in [0, radius {r}), found {ri}"),
+                ));
+            }
+            let phimax = ck.float("phimax", 360.0, Domain::LeftOpen(0.0, 360.0))?;
             vec![Shape::Disk(Disk::new(tt, ro, h, r, ri, phimax))]
         }
         "trianglemesh" => trianglemesh(s, t)?,
         "plymesh" => plymesh(s, t)?,
         "bilinearmesh" => bilinearmesh(s, t)?,
-        "loopsubdiv" => loopsubdiv(s, t)?,
+        "loopsubdiv" => loopsubdiv(&ck, s, t, budget)?,
         other => {
             return Err(BuildError::at(
                 &s.loc,
@@ -59,14 +82,36 @@ pub fn build_shape(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildErro
     })
 }
 
-/// `zmin`, `zmax` and `phimax` of a quadric.
-fn quadric_range(p: &ParamSet, zmin: f32, zmax: f32) -> Result<(f32, f32, f32), BuildError> {
-    Ok((
-        p.get_float("zmin", zmin)?,
-        p.get_float("zmax", zmax)?,
-        p.get_float("phimax", 360.0)?,
-    ))
+/// `zmin`, `zmax` and `phimax` of a quadric; `clamp` is a sphere's radius,
+/// to which pbrt-v4 clamps the z range.
+fn quadric_range(
+    ck: &Check<'_>,
+    zmin: f32,
+    zmax: f32,
+    clamp: Option<f32>,
+) -> Result<(f32, f32, f32), BuildError> {
+    let p = ck.params;
+    let (z0, z1) = (p.get_float("zmin", zmin)?, p.get_float("zmax", zmax)?);
+    let (lo, hi) = (z0.min(z1), z0.max(z1));
+    let (lo, hi) = match clamp {
+        Some(r) => (lo.clamp(-r, r), hi.clamp(-r, r)),
+        None => (lo, hi),
+    };
+    if lo >= hi {
+        let within = clamp.map_or(String::new(), |r| format!(" within the radius {r}"));
+        return Err(ck.error(
+            "zmax",
+            format!("and \"zmin\" ({z0} and {z1}) leave no surface{within}"),
+        ));
+    }
+    let phimax = ck.float("phimax", 360.0, Domain::LeftOpen(0.0, 360.0))?;
+    Ok((z0, z1, phimax))
 }
+
+/// Memory of one refined triangle, for the subdivision budget: 12 bytes of
+/// indices, a vertex's position and normal (24), its `Shape` and
+/// `Primitive` (about 64) and BVH share (about 32).
+const TRIANGLE_BYTES: u64 = 132;
 
 /// Object-space vertex data of a mesh directive.
 struct MeshInput {
@@ -245,18 +290,27 @@ fn bilinearmesh(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> 
 
 /// A Loop subdivision surface, refined into a triangle mesh with limit
 /// normals [pbrt-v4 `LoopSubdivide`].
-fn loopsubdiv(s: &ShapeDesc, t: &Transform) -> Result<Vec<Shape>, BuildError> {
+fn loopsubdiv(
+    ck: &Check<'_>,
+    s: &ShapeDesc,
+    t: &Transform,
+    budget: &mut Budget,
+) -> Result<Vec<Shape>, BuildError> {
     let p = &s.params;
-    let levels = p.get_int("levels", 3)?;
-    let levels = u32::try_from(levels).map_err(|_| {
-        BuildError::at(
-            &s.loc,
-            format!("loopsubdiv \"levels\" must be ≥ 0, not {levels}"),
-        )
-    })?;
+    let levels = ck.int_in("levels", 3, 0, MAX_LOOP_LEVELS)? as u32;
     let indices = p
         .get_ints("indices")?
         .ok_or_else(|| BuildError::at(&s.loc, "loopsubdiv needs \"integer indices\""))?;
+    // Each level makes four triangles of one; a triangle costs its indices,
+    // about one vertex (position and normal) and its primitive and BVH node.
+    let triangles = (indices.len() / 3) as u64 * 4u64.pow(levels);
+    budget
+        .claim(
+            triangles.saturating_mul(TRIANGLE_BYTES),
+            &format!("{triangles} triangles of the subdivided surface"),
+            "lower \"levels\"",
+        )
+        .map_err(|m| ck.error("levels", m))?;
     let pos = p
         .get_point3s("P")?
         .ok_or_else(|| BuildError::at(&s.loc, "loopsubdiv needs \"point3 P\""))?;

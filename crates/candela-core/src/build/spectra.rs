@@ -27,7 +27,8 @@ pub fn spectrum_param(
                 return Err(BuildError::at(
                     &loc,
                     format!(
-                        "\"{name}\": RGB values must be finite and non-negative, found {rgb:?}"
+                        "\"{name}\": RGB values must be finite and non-negative, found {} {} {}",
+                        rgb[0], rgb[1], rgb[2]
                     ),
                 ));
             }
@@ -38,7 +39,8 @@ pub fn spectrum_param(
                         return Err(BuildError::at(
                             &loc,
                             format!(
-                                "\"{name}\": a reflectance RGB must be at most 1, found {rgb:?}"
+                                "\"{name}\": a reflectance RGB must be at most 1 in each channel, found {} {} {}",
+                                rgb.r, rgb.g, rgb.b
                             ),
                         ));
                     }

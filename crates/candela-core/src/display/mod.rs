@@ -24,6 +24,7 @@
 //!
 //! [tev]: https://github.com/Tom94/tev
 
+pub mod decode;
 mod frame;
 mod live;
 pub mod tev;

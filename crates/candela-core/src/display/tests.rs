@@ -1,8 +1,9 @@
 //! Tests of the live view: a test viewer on 127.0.0.1 receives the stream and
-//! decodes it with a decoder written from tev's protocol description
-//! (`tev.rs` module doc), independent of the encoder.
+//! decodes it with [`super::decode`], written from tev's protocol
+//! description (`tev.rs` module doc), independent of the encoder.
 
-use super::tev::{self, Rect, MAX_PACKET_FLOATS, TILE_SIZE};
+use super::decode::{self, Packet as Decoded};
+use super::tev::{self, Rect};
 use super::*;
 use std::io::Read;
 use std::net::{SocketAddr, TcpListener};
@@ -10,174 +11,20 @@ use std::sync::mpsc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// A decoded packet.
-#[derive(Debug, PartialEq)]
-enum Decoded {
-    /// Type 4.
-    Create {
-        grab: bool,
-        name: String,
-        width: i32,
-        height: i32,
-        channels: Vec<String>,
-    },
-    /// Type 6; `data[c][p]` is channel c of pixel p of the rectangle.
-    Update {
-        name: String,
-        channels: Vec<String>,
-        rect: [i32; 4],
-        data: Vec<Vec<f32>>,
-        floats: usize,
-    },
-    /// Type 2.
-    Close { name: String },
-}
-
-/// A cursor over one packet.
-struct Cursor<'a>(&'a [u8], usize);
-
-impl Cursor<'_> {
-    fn take(&mut self, n: usize) -> &[u8] {
-        assert!(self.1 + n <= self.0.len(), "packet ends early");
-        self.1 += n;
-        &self.0[self.1 - n..self.1]
-    }
-    fn u8(&mut self) -> u8 {
-        self.take(1)[0]
-    }
-    fn bool(&mut self) -> bool {
-        match self.u8() {
-            0 => false,
-            1 => true,
-            b => panic!("bool byte {b}"),
-        }
-    }
-    fn i32(&mut self) -> i32 {
-        i32::from_le_bytes(self.take(4).try_into().unwrap())
-    }
-    fn i64(&mut self) -> i64 {
-        i64::from_le_bytes(self.take(8).try_into().unwrap())
-    }
-    fn str(&mut self) -> String {
-        let rest = &self.0[self.1..];
-        let n = rest
-            .iter()
-            .position(|&b| b == 0)
-            .expect("string without NUL");
-        let s = String::from_utf8(rest[..n].to_vec()).expect("UTF-8");
-        self.1 += n + 1;
-        s
-    }
-    fn strs(&mut self, n: i32) -> Vec<String> {
-        (0..n).map(|_| self.str()).collect()
-    }
-}
-
-/// Decodes one packet, checking its length field and that no byte is left.
+/// Decodes one packet (the decoder is `super::decode`, written from the
+/// protocol description independently of the encoder).
 fn decode(p: &[u8]) -> Decoded {
-    let mut c = Cursor(p, 0);
-    assert_eq!(c.take(4), (p.len() as u32).to_le_bytes(), "length prefix");
-    let d = match c.u8() {
-        4 => Decoded::Create {
-            grab: c.bool(),
-            name: c.str(),
-            width: c.i32(),
-            height: c.i32(),
-            channels: {
-                let n = c.i32();
-                c.strs(n)
-            },
-        },
-        6 => {
-            let _grab = c.bool();
-            let name = c.str();
-            let n = c.i32();
-            let channels = c.strs(n);
-            let rect = [c.i32(), c.i32(), c.i32(), c.i32()];
-            let offsets: Vec<i64> = (0..n).map(|_| c.i64()).collect();
-            let strides: Vec<i64> = (0..n).map(|_| c.i64()).collect();
-            let pixels = (rect[2] * rect[3]) as i64;
-            let floats = (0..n as usize)
-                .map(|k| offsets[k] + (pixels - 1) * strides[k] + 1)
-                .max()
-                .unwrap() as usize;
-            let raw: Vec<f32> = c
-                .take(4 * floats)
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
-                .collect();
-            let data = (0..n as usize)
-                .map(|k| {
-                    let at = |p: i64| raw[(offsets[k] + p * strides[k]) as usize];
-                    (0..pixels).map(at).collect()
-                })
-                .collect();
-            Decoded::Update {
-                name,
-                channels,
-                rect,
-                data,
-                floats,
-            }
-        }
-        2 => Decoded::Close { name: c.str() },
-        t => panic!("unexpected packet type {t}"),
-    };
-    assert_eq!(c.1, p.len(), "trailing bytes in packet");
-    d
+    decode::decode_packet(p).unwrap()
 }
 
-/// Splits a received stream into packets by their length prefixes.
+/// Splits a received stream into packets.
 fn packets(stream: &[u8]) -> Vec<Decoded> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < stream.len() {
-        assert!(i + 5 <= stream.len(), "stream ends inside a length prefix");
-        let n = u32::from_le_bytes(stream[i..i + 4].try_into().unwrap()) as usize;
-        assert!(n >= 5 && i + n <= stream.len(), "bad packet length {n}");
-        out.push(decode(&stream[i..i + n]));
-        i += n;
-    }
-    out
+    decode::decode_stream(stream).unwrap()
 }
 
-/// The image the updates paint, per channel name, with a count of writes per
-/// sample; checks tile bounds and packet sizes on the way.
+/// The image the updates paint and the writes per sample.
 fn paint(packets: &[Decoded], w: usize, h: usize, names: &[String]) -> (Vec<Vec<f32>>, Vec<u32>) {
-    let mut img = vec![vec![f32::NAN; w * h]; names.len()];
-    let mut writes = vec![0u32; w * h * names.len()];
-    for p in packets {
-        let Decoded::Update {
-            channels,
-            rect: [x0, y0, tw, th],
-            data,
-            floats,
-            ..
-        } = p
-        else {
-            continue;
-        };
-        assert!(
-            *tw as usize <= TILE_SIZE && *th as usize <= TILE_SIZE,
-            "tile {tw}x{th}"
-        );
-        assert!(
-            *floats <= MAX_PACKET_FLOATS,
-            "{floats} floats in one packet"
-        );
-        for (ch, plane) in channels.iter().zip(data) {
-            let c = names.iter().position(|n| n == ch).expect("known channel");
-            for (p, &v) in plane.iter().enumerate() {
-                let (x, y) = (
-                    *x0 as usize + p % *tw as usize,
-                    *y0 as usize + p / *tw as usize,
-                );
-                img[c][y * w + x] = v;
-                writes[(y * w + x) * names.len() + c] += 1;
-            }
-        }
-    }
-    (img, writes)
+    decode::paint(packets, w, h, names).unwrap()
 }
 
 /// Asserts that `img` (per channel) holds exactly the samples of `frame`.

@@ -80,7 +80,7 @@ impl PassBlock {
         let nb = self.layout.n_buckets();
         let (direct, spectral) = (
             super::layout::MAIN_DIRECT,
-            self.layout.spectral_offset() + 2 * nb,
+            self.layout.spectral_direct_offset(),
         );
         for i in 0..self.pixel_count() {
             let (row, src) = (i * self.stride, i * buf.stride);

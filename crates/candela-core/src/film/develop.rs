@@ -120,13 +120,13 @@ fn spectral_channels(film: &Film, state: &FilmState, inv_n: f64, out: &mut Vec<C
             .replace('.', ",")
             .replacen(',', ".", 1);
         out.push(per_pixel(state, name, |i| {
-            let w = state.value(i, o + b.n + k);
-            let avg = if w > 0.0 {
+            let w = state.value(i, MAIN_W);
+            let avg = if w != 0.0 {
                 state.value(i, o + k) / w
             } else {
                 0.0
             };
-            avg + state.value(i, o + 2 * b.n + k) * inv_n
+            avg + state.value(i, o + b.n + k) * inv_n
         }));
     }
 }

@@ -133,6 +133,29 @@ impl Default for Filter {
 }
 
 impl Filter {
+    /// pbrt-v4's default radius of `kind`.
+    pub fn default_radius(kind: FilterKind) -> Vec2 {
+        Vec2::splat(match kind {
+            FilterKind::Box => 0.5,
+            FilterKind::Gaussian => 1.5,
+            FilterKind::Mitchell | FilterKind::Triangle => 2.0,
+            FilterKind::LanczosSinc => 4.0,
+        })
+    }
+
+    /// Bytes of the sampling table [`Filter::new`] would build: 32 cells per
+    /// unit of radius along each axis, each a tabulated value, the sampling
+    /// distribution's density and CDF entry and the f64 CDF it is summed in
+    /// (0 for box and triangle).
+    pub fn table_bytes(kind: FilterKind, p: &FilterParams) -> u64 {
+        if matches!(kind, FilterKind::Box | FilterKind::Triangle) {
+            return 0;
+        }
+        let r = p.radius.unwrap_or(Self::default_radius(kind));
+        let cells = |x: f32| (32.0 * x as f64).max(1.0);
+        (cells(r.x) * cells(r.y) * 20.0) as u64
+    }
+
     /// Builds a filter, filling unset parameters with pbrt-v4's defaults.
     pub fn new(kind: FilterKind, p: &FilterParams) -> Self {
         let r = |d: f32| p.radius.unwrap_or(Vec2::splat(d));

@@ -6,7 +6,7 @@
 //! | group | channels | developed as |
 //! |---|---|---|
 //! | main | Σw·rgb (3), Σw, Σdirect rgb (3) | Σw·rgb/Σw + Σdirect/passes, sensor RGB → output RGB |
-//! | spectral | Σw·L_b, Σw_b, Σdirect L_b per bucket | Σw·L_b/Σw_b + Σdirect L_b/passes |
+//! | spectral | Σw·L̄_b, then Σdirect L̄_b, per bucket | Σw·L̄_b/Σw + Σdirect L̄_b/passes |
 //! | surface | Σw, then Σw·x for each requested first-hit value | Σw·x/Σw (normals normalised) |
 //! | strategies | Σdirect rgb (3) per BDPT strategy | Σ/passes |
 //! | variance (state only) | Σv (3), Σv² (3) of per-pass pixel values v | see [`super::state`] |
@@ -15,6 +15,19 @@
 //! `rgbSum`/`weightSum`); "direct" channels hold values that are already
 //! estimates of the pixel (light-tracing splats, PPM's per-pass estimates),
 //! which the film averages over passes.
+//!
+//! A spectral bucket b of width Δ_b holds, per camera sample, the estimate
+//! L̄_b = Σ_i 1_b(λ_i)·L(λ_i)/(p(λ_i)·n·Δ_b) of the radiance averaged over
+//! the bucket (n wavelengths λ_i of density p per sample): its expectation
+//! is (1/Δ_b)∫_b L dλ whatever the wavelength density, so the buckets share
+//! the main layer's weight Σw. (pbrt-v4's `SpectralFilm` samples λ
+//! uniformly and averages L per bucket with per-bucket weights; candela's
+//! integrators sample the visible-light density, hence the division by p.)
+//!
+//! The surface group's weight Σw counts every camera sample of the
+//! first-hit pass, hits or not: a sample that escapes adds zeros, so, as
+//! in pbrt-v4's `GBufferFilm`, a pixel half covered by an object reads half
+//! its albedo.
 
 /// First-hit values a film can record (pbrt-v4's `VisibleSurface`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -49,6 +62,63 @@ impl SurfaceAov {
     }
 }
 
+/// A layer `--aov` can ask for: a first-hit value, or the per-pixel variance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Aov {
+    /// A first-hit value.
+    Surface(SurfaceAov),
+    /// Variance of the pixel estimate (from the spread of the passes).
+    Variance,
+}
+
+impl Aov {
+    /// Every layer with its `--aov` name, in the canonical order.
+    pub const ALL: [(&'static str, Aov); 8] = [
+        ("albedo", Aov::Surface(SurfaceAov::Albedo)),
+        ("position", Aov::Surface(SurfaceAov::Position)),
+        ("normal", Aov::Surface(SurfaceAov::Normal)),
+        ("shading_normal", Aov::Surface(SurfaceAov::ShadingNormal)),
+        ("depth", Aov::Surface(SurfaceAov::Depth)),
+        ("uv", Aov::Surface(SurfaceAov::Uv)),
+        ("dzdxy", Aov::Surface(SurfaceAov::DepthGradient)),
+        ("variance", Aov::Variance),
+    ];
+
+    /// The `--aov` name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, a)| *a == self)
+            .map_or("?", |(n, _)| n)
+    }
+
+    /// Parses a comma-separated list of names into a sorted list without repeats.
+    pub fn parse_list(s: &str) -> Result<Vec<Aov>, String> {
+        let mut out = Vec::new();
+        for t in s.split(',').map(str::trim) {
+            let Some((_, a)) = Self::ALL.iter().find(|(n, _)| *n == t) else {
+                let names: Vec<&str> = Self::ALL.iter().map(|(n, _)| *n).collect();
+                return Err(format!(
+                    "unknown layer \"{t}\" (known: {})",
+                    names.join(", ")
+                ));
+            };
+            out.push(*a);
+        }
+        out.sort_unstable();
+        out.dedup();
+        Ok(out)
+    }
+
+    /// The canonical text of a list, as [`Aov::parse_list`] reads it.
+    pub fn list_text(list: &[Aov]) -> String {
+        let mut v = list.to_vec();
+        v.sort_unstable();
+        v.dedup();
+        v.iter().map(|a| a.name()).collect::<Vec<_>>().join(",")
+    }
+}
+
 /// Spectral buckets of a `spectral` film (pbrt-v4's `SpectralFilm`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Buckets {
@@ -69,6 +139,11 @@ impl Buckets {
             return None;
         }
         Some(((t * self.n as f32) as usize).min(self.n - 1))
+    }
+
+    /// Width of every bucket (nm).
+    pub fn width(&self) -> f32 {
+        (self.lambda_max - self.lambda_min) / self.n as f32
     }
 
     /// Centre wavelength of bucket `i` (nm).
@@ -100,6 +175,21 @@ pub const MAIN_DIRECT: usize = 4;
 const MAIN: usize = 7;
 
 impl FilmLayout {
+    /// The same layout also recording `aovs`: first-hit values it lacks are
+    /// appended in the canonical order (those it has keep their place).
+    pub fn with_aovs(mut self, aovs: &[Aov]) -> Self {
+        let mut aovs = aovs.to_vec();
+        aovs.sort_unstable();
+        for a in aovs {
+            match a {
+                Aov::Surface(s) if !self.surface.contains(&s) => self.surface.push(s),
+                Aov::Surface(_) => {}
+                Aov::Variance => self.variance = true,
+            }
+        }
+        self
+    }
+
     /// Number of spectral buckets (0 without a spectral layer).
     pub fn n_buckets(&self) -> usize {
         self.spectral.map_or(0, |b| b.n)
@@ -108,9 +198,13 @@ impl FilmLayout {
     pub fn spectral_offset(&self) -> usize {
         MAIN
     }
+    /// Offset of the spectral direct sums.
+    pub fn spectral_direct_offset(&self) -> usize {
+        MAIN + self.n_buckets()
+    }
     /// Offset of the surface group (its weight first).
     pub fn surface_offset(&self) -> usize {
-        MAIN + 3 * self.n_buckets()
+        MAIN + 2 * self.n_buckets()
     }
     /// Channels of the surface group, weight included (0 when none is recorded).
     pub fn surface_width(&self) -> usize {
@@ -173,20 +267,46 @@ mod tests {
             variance: true,
             strategies: 2,
         };
-        assert_eq!(l.surface_offset(), 7 + 12);
-        assert_eq!(l.surface_channel(SurfaceAov::Albedo), Some(20));
-        assert_eq!(l.surface_channel(SurfaceAov::Depth), Some(23));
+        assert_eq!(l.spectral_direct_offset(), 7 + 4);
+        assert_eq!(l.surface_offset(), 7 + 8);
+        assert_eq!(l.surface_channel(SurfaceAov::Albedo), Some(16));
+        assert_eq!(l.surface_channel(SurfaceAov::Depth), Some(19));
         assert_eq!(l.surface_channel(SurfaceAov::Uv), None);
-        assert_eq!(l.strategy_offset(), 24);
-        assert_eq!(l.pass_stride(), 30);
-        assert_eq!(l.state_stride(), 36);
-        assert_eq!(l.bits(32), super::super::fixed::VALUE_BITS);
-        assert_eq!(l.bits(33), super::super::fixed::SQUARE_BITS);
+        assert_eq!(l.strategy_offset(), 20);
+        assert_eq!(l.pass_stride(), 26);
+        assert_eq!(l.state_stride(), 32);
+        assert_eq!(l.bits(28), super::super::fixed::VALUE_BITS);
+        assert_eq!(l.bits(29), super::super::fixed::SQUARE_BITS);
         let b = l.spectral.unwrap();
         assert_eq!(b.bucket(400.0), Some(0));
         assert_eq!(b.bucket(799.9), Some(3));
         assert_eq!(b.bucket(800.0), Some(3));
         assert_eq!(b.bucket(300.0), None);
         assert_eq!(b.centre(0), 450.0);
+        assert_eq!(b.width(), 100.0);
+    }
+
+    #[test]
+    fn aov_lists_parse_into_one_canonical_layout() {
+        let a = Aov::parse_list("depth, albedo,variance,depth").unwrap();
+        let b = Aov::parse_list("variance,albedo,depth").unwrap();
+        let (la, lb) = (
+            FilmLayout::default().with_aovs(&a),
+            FilmLayout::default().with_aovs(&b),
+        );
+        assert_eq!(la, lb);
+        assert_eq!(la.surface, vec![SurfaceAov::Albedo, SurfaceAov::Depth]);
+        assert!(la.variance);
+        assert_eq!(Aov::list_text(&a), "albedo,depth,variance");
+        assert_eq!(
+            Aov::parse_list(&Aov::list_text(&a)).unwrap(),
+            Aov::parse_list("albedo,depth,variance").unwrap()
+        );
+        let e = Aov::parse_list("albedo,colour").unwrap_err();
+        assert!(
+            e.contains("\"colour\"") && e.contains("shading_normal"),
+            "{e}"
+        );
+        assert!(Aov::parse_list("").is_err());
     }
 }

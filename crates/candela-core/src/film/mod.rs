@@ -25,12 +25,12 @@ mod tile;
 
 pub use block::PassBlock;
 pub use develop::{Channel, Developed};
-pub use layout::{Buckets, FilmLayout, SurfaceAov};
+pub use layout::{Aov, Buckets, FilmLayout, SurfaceAov};
 pub use state::{FilmState, MergeError, PassSet};
 pub use tile::{FilmTile, SplatBuffer, SurfaceSample};
 
-use crate::math::{Mat3, Transform, UVec2};
-use crate::spectrum::PixelSensor;
+use crate::math::{Mat3, UVec2};
+use crate::spectrum::{ColorSpace, PixelSensor};
 use filter::Filter;
 use tile::Encoder;
 
@@ -57,12 +57,13 @@ pub enum FilmKind {
 }
 
 /// The space first-hit positions and normals are recorded in.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SurfaceSpace {
     /// World space.
     World,
-    /// Camera space (pbrt-v4 `gbuffer` default).
-    Camera(Transform),
+    /// Camera space: the camera at the origin looking down +z, +y up
+    /// (pbrt-v4's camera space; the `gbuffer` default).
+    Camera,
 }
 
 /// The film's configuration.
@@ -75,6 +76,7 @@ pub struct Film {
     layout: FilmLayout,
     kind: FilmKind,
     surface_space: SurfaceSpace,
+    color_space: &'static ColorSpace,
 }
 
 impl Film {
@@ -94,7 +96,20 @@ impl Film {
             layout: FilmLayout::default(),
             kind: FilmKind::Rgb,
             surface_space: SurfaceSpace::World,
+            color_space: ColorSpace::srgb(),
         }
+    }
+
+    /// The same film with output colour space `cs` (whose illuminant and
+    /// primaries turn first-hit albedos into output RGB; sRGB by default).
+    pub fn with_color_space(mut self, cs: &'static ColorSpace) -> Self {
+        self.color_space = cs;
+        self
+    }
+
+    /// The output colour space.
+    pub fn color_space(&self) -> &'static ColorSpace {
+        self.color_space
     }
 
     /// The same film recording `layout`, with channels named as `kind`.

@@ -44,15 +44,16 @@ impl Encoder {
         )
     }
 
-    /// Adds w·L/(p(λ)·n) of each wavelength to its bucket (pbrt-v4's
-    /// `SpectralFilm::AddSample`); `weights`, if given, gets w per wavelength.
+    /// Adds w·L(λ)/(p(λ)·n·Δ) of each wavelength λ to its bucket: an
+    /// estimate of the radiance averaged over the bucket (see
+    /// [`super::layout`]; pbrt-v4's `SpectralFilm::AddSample` with
+    /// non-uniform wavelength densities).
     fn add_spectral(
         &self,
         l: SampledSpectrum,
         lambda: &SampledWavelengths,
         w: f64,
         sums: &mut [f64],
-        mut weights: Option<&mut [f64]>,
     ) {
         let Some(b) = self.buckets else { return };
         let lm = l.max_component();
@@ -61,17 +62,14 @@ impl Encoder {
         } else {
             l
         };
-        let n = l.0.len() as f32;
+        let scale = w / (l.0.len() as f64 * b.width() as f64);
         let pdf = lambda.pdf();
         for i in 0..l.0.len() {
             let Some(k) = b.bucket(lambda.lambda(i)) else {
                 continue;
             };
             if pdf.0[i] > 0.0 {
-                sums[k] += w * (l.0[i] / (pdf.0[i] * n)) as f64;
-            }
-            if let Some(ws) = weights.as_deref_mut() {
-                ws[k] += w;
+                sums[k] += scale * (l.0[i] / pdf.0[i]) as f64;
             }
         }
     }
@@ -93,13 +91,13 @@ pub struct FilmTile {
 pub struct SurfaceSample {
     /// Albedo in output RGB.
     pub albedo: [f32; 3],
-    /// Position.
+    /// Position (world or camera space, [`super::SurfaceSpace`]).
     pub p: [f32; 3],
-    /// Geometric normal.
+    /// Geometric normal, facing the ray.
     pub n: [f32; 3],
-    /// Shading normal.
+    /// Shading normal, facing the ray.
     pub ns: [f32; 3],
-    /// Distance from the lens.
+    /// Distance from the ray's origin on the lens.
     pub depth: f32,
     /// Surface (u, v).
     pub uv: [f32; 2],
@@ -167,8 +165,7 @@ impl FilmTile {
         }
         row[layout::MAIN_W] += w;
         if nb > 0 {
-            let (sums, weights) = row[so..so + 2 * nb].split_at_mut(nb);
-            self.enc.add_spectral(l, lambda, w, sums, Some(weights));
+            self.enc.add_spectral(l, lambda, w, &mut row[so..so + nb]);
         }
     }
 
@@ -259,7 +256,7 @@ impl SplatBuffer {
                 }
                 if self.stride > 3 {
                     let spectral = &mut self.sums[i + 3..i + self.stride];
-                    self.enc.add_spectral(l, lambda, w as f64, spectral, None);
+                    self.enc.add_spectral(l, lambda, w as f64, spectral);
                 }
             }
         }
@@ -286,7 +283,7 @@ impl SplatBuffer {
         }
         if self.stride > 3 {
             let spectral = &mut self.sums[i + 3..i + self.stride];
-            self.enc.add_spectral(l, lambda, 1.0, spectral, None);
+            self.enc.add_spectral(l, lambda, 1.0, spectral);
         }
     }
 }

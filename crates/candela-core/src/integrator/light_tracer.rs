@@ -18,12 +18,13 @@
 //! added in lane order: the image is bit-identical for any thread count.
 
 use super::driver::LANES;
+use super::roulette::Roulette;
+use super::subpath::{start_light_subpath, walk, Dispersion, Flow, Vertex, Visitor, Walk};
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
-use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::{PassBlock, SplatBuffer};
-use crate::interaction::SurfaceInteraction;
 use crate::math::Vec2;
-use crate::sampling::{hash_u64s, Pcg32};
+use crate::sampling::{hash_u64s, PathRng, StreamRng};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
@@ -104,118 +105,88 @@ fn paths_per_pass(ctx: &RenderContext<'_>) -> u64 {
     res.x as u64 * res.y as u64
 }
 
-/// Uniform numbers of one path, seeded from (seed, path index).
-struct PathRng(Pcg32);
-
-impl PathRng {
-    fn new(seed: u64, index: u64) -> Self {
-        Self(Pcg32::new(hash_u64s(&[seed, index]), 0))
-    }
-    fn u1(&mut self) -> f32 {
-        self.0.uniform_f32()
-    }
-    fn u2(&mut self) -> Vec2 {
-        Vec2::new(self.0.uniform_f32(), self.0.uniform_f32())
-    }
-}
-
 impl LightTracer {
     /// Traces light path `index` and splats its camera connections.
     fn trace_path(&self, ctx: &RenderContext<'_>, index: u64, buf: &mut SplatBuffer) {
         let scene = ctx.scene;
-        let mut rng = PathRng::new(self.settings.seed, index);
-        let lambda = SampledWavelengths::sample_visible(rng.u1());
-        let Some((id, p_light)) = scene.light_sampler().sample(rng.u1()) else {
+        let mut rng = StreamRng::with_hash(hash_u64s(&[self.settings.seed, index]));
+        let mut lambda = SampledWavelengths::sample_visible(rng.u1());
+        let Some(ls) = start_light_subpath(scene, &lambda, &mut rng, None) else {
             return;
         };
-        let light = scene.light(id);
-        let Some(les) = light.sample_le(rng.u2(), rng.u2(), &lambda) else {
-            return;
-        };
-        let les = les.at_time(scene.sample_time(|| rng.u1()));
-        if les.pdf_pos.0 == 0.0 || les.pdf_dir.0 == 0.0 || les.l.is_black() {
-            return;
-        }
         // s = 1: the light point seen directly by the camera (visible area lights only).
-        if let Some(it) = les.intr.filter(|it| it.is_surface() && light.is_hittable()) {
+        let it = ls.vertex.it;
+        let hittable = ls
+            .vertex
+            .light_id()
+            .is_some_and(|id| scene.light(id).is_hittable());
+        if it.is_surface() && hittable {
             if let Some(cs) = ctx.camera.sample_wi(&it, rng.u2()) {
                 if cs.pdf.0 > 0.0 && scene.unoccluded(&it, &cs.p_lens) {
-                    let le = light.l(it.p, it.n, it.uv, cs.wi, &lambda);
+                    let le = ls.vertex.light_id().map_or(SampledSpectrum::zero(), |id| {
+                        scene.light(id).l(it.p, it.n, it.uv, cs.wi, &lambda)
+                    });
                     let l =
-                        le * (cs.wi.dot(it.n).abs() * cs.we / (p_light * les.pdf_pos.0 * cs.pdf.0));
+                        le * (cs.wi.dot(it.n).abs() * cs.we / (ls.pmf * ls.pdf_pos.0 * cs.pdf.0));
                     buf.add(cs.p_raster, l, &lambda);
                 }
             }
         }
-        let mut beta = les.beta0(p_light);
-        let mut ray = les.ray;
-        let mut depth = 0;
-        let mut lambda = lambda;
-        while !beta.is_black() {
-            let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
-                break;
-            };
-            // A connection here closes a path with `depth` scattering events, as
-            // many as the path tracer allows for the same maxdepth.
-            depth += 1;
-            if depth > self.settings.max_depth {
-                break;
-            }
-            let Some(bsdf) = scene.bsdf(&mut si, &mut lambda) else {
-                ray = si.spawn_ray(ray.d);
-                depth -= 1;
-                continue;
-            };
-            if bsdf.flags().is_non_specular() {
-                self.connect_to_camera(ctx, &si, &bsdf, beta, &lambda, rng.u2(), buf);
-            }
-            let Some(bs) = bsdf.sample_f(
-                si.wo,
-                rng.u1(),
-                rng.u2(),
-                TransportMode::Importance,
-                SampleFlags::ALL,
-            ) else {
-                break;
-            };
-            beta *= bs.f
-                * (si.importance_shading_correction(si.wo, bs.wi) * bs.wi.dot(bsdf.ns()).abs()
-                    / bs.pdf.0);
-            ray = si.spawn_ray(bs.wi);
-            // Russian roulette on the carried power after a few bounces.
-            let m = beta.max_component();
-            if depth > 3 && m < 1.0 {
-                let q = (1.0 - m).max(0.05);
-                if rng.u1() < q {
-                    break;
-                }
-                beta /= 1.0 - q;
-            }
-        }
-    }
-
-    /// t = 1 connection of a surface vertex to a sampled lens point.
-    fn connect_to_camera(
-        &self,
-        ctx: &RenderContext<'_>,
-        si: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        beta: SampledSpectrum,
-        lambda: &SampledWavelengths,
-        u: Vec2,
-        buf: &mut SplatBuffer,
-    ) {
-        let Some(cs) = ctx.camera.sample_wi(&si.it, u) else {
-            return;
+        let w = Walk {
+            mode: TransportMode::Importance,
+            max_depth: self.settings.max_depth,
+            roulette: Some(Roulette::Bidirectional),
+            regularize: false,
+            dispersion: Dispersion::Keep,
         };
-        if cs.pdf.0 == 0.0 || cs.we == 0.0 {
-            return;
-        }
-        let f = bsdf.f(si.wo, cs.wi, TransportMode::Importance);
-        if f.is_black() || !ctx.scene.unoccluded(&si.it, &cs.p_lens) {
-            return;
-        }
-        let g = si.importance_shading_correction(si.wo, cs.wi) * cs.wi.dot(bsdf.ns()).abs();
-        buf.add(cs.p_raster, beta * f * (g * cs.we / cs.pdf.0), lambda);
+        let mut splat = Splat { ctx, buf };
+        walk(scene, &mut lambda, &mut rng, &w, ls.start, &mut splat);
     }
+}
+
+/// The light tracer's visitor: every non-specular vertex is connected to the camera.
+struct Splat<'a, 'b> {
+    ctx: &'a RenderContext<'b>,
+    buf: &'a mut SplatBuffer,
+}
+
+impl Visitor<StreamRng> for Splat<'_, '_> {
+    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut StreamRng) -> Flow {
+        if let Some(bsdf) = &v.bsdf {
+            if bsdf.flags().is_non_specular() {
+                connect_to_camera(self.ctx, v, bsdf, lambda, rng.u2(), self.buf);
+            }
+        }
+        Flow::Continue
+    }
+}
+
+/// t = 1 connection of a surface vertex to a sampled lens point.
+fn connect_to_camera(
+    ctx: &RenderContext<'_>,
+    v: &Vertex,
+    bsdf: &Bsdf,
+    lambda: &SampledWavelengths,
+    u: Vec2,
+    buf: &mut SplatBuffer,
+) {
+    let Some(cs) = ctx.camera.sample_wi(&v.it, u) else {
+        return;
+    };
+    if cs.pdf.0 == 0.0 || cs.we == 0.0 {
+        return;
+    }
+    let f = bsdf.f(v.wo, cs.wi, TransportMode::Importance);
+    if f.is_black() || !ctx.scene.unoccluded(&v.it, &cs.p_lens) {
+        return;
+    }
+    let (ns, ng) = (v.ns, v.it.n);
+    let den = v.wo.dot(ng).abs() * cs.wi.dot(ns).abs();
+    let corr = if den == 0.0 {
+        0.0
+    } else {
+        v.wo.dot(ns).abs() * cs.wi.dot(ng).abs() / den
+    };
+    let g = corr * cs.wi.dot(bsdf.ns()).abs();
+    buf.add(cs.p_raster, v.beta * f * (g * cs.we / cs.pdf.0), lambda);
 }

@@ -19,13 +19,16 @@
 //! parallel pixel loop of [`driver`].
 
 mod bdpt;
-mod direct;
+pub mod camera_walk;
 pub mod driver;
 mod light_tracer;
+pub mod nee;
 mod path;
 pub mod photon;
 pub mod photonmap;
+pub mod roulette;
 pub mod sppm;
+pub mod subpath;
 
 pub use bdpt::{BdptIntegrator, BdptSettings, MisHeuristic, Visualize};
 pub use light_tracer::{LightTracer, LightTracerSettings};

@@ -5,9 +5,10 @@
 //! direct light: a light sample (NEE) and the continuation BSDF sample that
 //! happens to hit an emitter, weighted by the power heuristic (β = 2,
 //! [Veach 1997, eq. 9.13]). Delta lights and specular bounces have a single
-//! strategy and weight 1. Paths end by Russian roulette on the throughput
-//! (corrected by the accumulated η² so refraction does not bias it, as pbrt-v4)
-//! or at `maxdepth` scattering events.
+//! strategy and weight 1 ([`crate::integrator::nee`]). Paths end by Russian
+//! roulette on the throughput ([`Roulette::Throughput`]: corrected by the
+//! accumulated η² so refraction does not bias it, as pbrt-v4) or at
+//! `maxdepth` scattering events.
 //!
 //! Stochastic layered BSDFs return samples whose pdf is only proportional to
 //! the true density (`pdf_is_proportional`): f/p is still the right throughput
@@ -15,6 +16,8 @@
 //! that next-event estimation uses, `Bsdf::pdf`, or the two weights of one
 //! direction would not sum to one [pbrt-v4 §14.3.3, `PathIntegrator::Li`].
 
+use super::nee::{sample_light, Receiver};
+use super::roulette::Roulette;
 use super::{
     driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, PixelEstimator,
     RenderContext,
@@ -130,7 +133,10 @@ impl PixelEstimator for PathIntegrator {
             }
             let wo = -ray.d.normalize();
             if bsdf.flags().is_non_specular() {
-                st.l += st.beta * self.sample_direct(scene, &si, &bsdf, wo, lambda, sampler);
+                let r = Receiver::at_hit(&si, &bsdf, wo);
+                if let Some(ls) = sample_light(scene, &r, lambda, sampler) {
+                    st.l += st.beta * ls.bsdf_mis_weighted(scene, &r);
+                }
             }
             let Some(bs) = bsdf.sample_f(
                 wo,
@@ -198,44 +204,6 @@ impl PathIntegrator {
         }
     }
 
-    /// Next-event estimation: one light sample, MIS-weighted against BSDF sampling.
-    fn sample_direct(
-        &self,
-        scene: &Scene,
-        si: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-    ) -> SampledSpectrum {
-        let ctx = LightSampleContext::from_surface(si);
-        let u_light = sampler.get_1d();
-        let u = sampler.get_2d();
-        let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
-            return SampledSpectrum::zero();
-        };
-        let light = scene.light(id);
-        let Some(ls) = light.sample_li(&ctx, u, lambda) else {
-            return SampledSpectrum::zero();
-        };
-        if ls.l.is_black() || ls.pdf.0 == 0.0 {
-            return SampledSpectrum::zero();
-        }
-        let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(bsdf.ns()).abs();
-        if f.is_black() || !scene.unoccluded(&si.it, &ls.p_light) {
-            return SampledSpectrum::zero();
-        }
-        let p_l = pmf * ls.pdf.0;
-        if !light.is_hittable() {
-            // BSDF sampling cannot find it: light sampling takes all the weight.
-            return f * ls.l / p_l;
-        }
-        let p_bsdf = bsdf
-            .pdf(wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
-            .0;
-        f * ls.l * (power_heuristic(1.0, p_l, 1.0, p_bsdf) / p_l)
-    }
-
     /// Updates throughput and MIS state after a BSDF sample.
     fn scatter(
         &self,
@@ -261,19 +229,12 @@ impl PathIntegrator {
         st.prev_ctx = LightSampleContext::from_surface(si);
     }
 
-    /// Russian roulette after the first bounces; returns false to stop.
+    /// Russian roulette ([`Roulette::Throughput`]); returns false to stop.
     fn russian_roulette(&self, st: &mut PathState, sampler: &mut Sampler) -> bool {
         if st.beta.is_black() {
             return false;
         }
-        let rr_beta = (st.beta * st.eta_scale).max_component();
-        if rr_beta < 1.0 && st.depth > 1 {
-            let q = (1.0 - rr_beta).max(0.0);
-            if sampler.get_1d() < q {
-                return false;
-            }
-            st.beta /= 1.0 - q;
-        }
-        true
+        let before = st.beta;
+        Roulette::Throughput.play(st.depth, &before, &mut st.beta, st.eta_scale, sampler)
     }
 }

@@ -6,6 +6,7 @@
 //! for pass in passes not yet in the state {
 //!     stop requested, time or error budget spent?  → stop
 //!     integrator.render_pass(ctx, pass, &mut integrator_state, &mut block)
+//!     surface::render_surface_pass(ctx, pass, &mut block)   (first-hit layers, if any)
 //!     film_state.add_pass(pass, block)            (exact, fixed point)
 //!     on_pass(state)                              (live view, …)
 //!     checkpoint if due
@@ -28,6 +29,7 @@ mod exr;
 mod fingerprint;
 mod settings;
 mod state;
+pub mod surface;
 
 pub use exr::{encode_exr, exr_attributes, exr_layers};
 pub use fingerprint::fingerprint;
@@ -168,6 +170,11 @@ pub fn check_options(
     opts: &RenderOptions,
 ) -> Result<(), RenderError> {
     let kind = setup.integrator.kind();
+    if state.film.layout != *setup.film.layout() || state.film.pixels != setup.film.pixel_count() {
+        return Err(RenderError::Options(
+            "the state is of a film with other pixel bounds or layers".into(),
+        ));
+    }
     if state.integrator != kind.name() {
         return Err(RenderError::Options(format!(
             "the state is of a \"{}\" render, not \"{}\"",
@@ -176,6 +183,17 @@ pub fn check_options(
         )));
     }
     if kind == IntegratorKind::Sppm {
+        let layout = setup.film.layout();
+        if layout.spectral.is_some() {
+            return Err(RenderError::Options(
+                "Film \"spectral\" cannot be rendered with sppm: its radiance estimate τ is accumulated in RGB (use ppm, whose passes fill the spectral buckets)".into(),
+            ));
+        }
+        if layout.variance {
+            return Err(RenderError::Options(
+                "the variance layer (--aov variance, Film \"gbuffer\") needs independent passes; SPPM's iterations depend on each other (use ppm)".into(),
+            ));
+        }
         if opts.target_error.is_some() {
             return Err(RenderError::Options(
                 "--target-error needs independent passes; SPPM's iterations depend on each other (use ppm)".into(),
@@ -228,10 +246,10 @@ pub fn render(
         status: shared.status.lock().map(|s| s.clone()).unwrap_or(None),
     };
     let result = std::thread::scope(|s| {
-        s.spawn(|| {
+        let ticker = s.spawn(|| {
             while !shared.finished.load(Ordering::Relaxed) {
                 progress.update(&snap());
-                std::thread::sleep(Duration::from_millis(250));
+                std::thread::park_timeout(Duration::from_millis(250));
             }
         });
         let r = run_passes(setup, state, opts, &ctx, &todo, &shared, t0, &mut |st| {
@@ -239,6 +257,7 @@ pub fn render(
             on_pass(st);
         });
         shared.finished.store(true, Ordering::Relaxed);
+        ticker.thread().unpark();
         r
     });
     let (reason, passes_rendered) = result?;
@@ -282,6 +301,11 @@ fn run_passes(
                 .integrator
                 .render_pass(ctx, pass, &mut state.integrator_state, &mut block);
         if outcome == PassOutcome::Cancelled {
+            return Ok((StopReason::Interrupted, rendered));
+        }
+        if !setup.film.layout().surface.is_empty()
+            && surface::render_surface_pass(ctx, pass, &mut block) == PassOutcome::Cancelled
+        {
             return Ok((StopReason::Interrupted, rendered));
         }
         state.film.add_pass(&setup.film, pass, &block);

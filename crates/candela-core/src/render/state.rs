@@ -184,6 +184,39 @@ impl RenderState {
     }
 }
 
+#[cfg(test)]
+mod tests {
+    use super::{put_varint, Reader};
+
+    #[test]
+    fn varints_round_trip_at_the_extremes() {
+        for v in [
+            0,
+            1,
+            -1,
+            63,
+            -64,
+            64,
+            1 << 70,
+            -(1 << 100),
+            i128::MAX,
+            i128::MIN,
+        ] {
+            let mut b = Vec::new();
+            put_varint(&mut b, v);
+            assert!(b.len() <= 19);
+            let mut r = Reader { b: &b, at: 0 };
+            assert_eq!(r.varint().ok(), Some(v), "{v}");
+            assert_eq!(r.at, b.len());
+        }
+        let mut r = Reader {
+            b: &[0xff; 30],
+            at: 0,
+        };
+        assert!(r.varint().is_err(), "an unterminated varint is refused");
+    }
+}
+
 fn put_u64(out: &mut Vec<u8>, v: u64) {
     out.extend_from_slice(&v.to_le_bytes());
 }
@@ -222,10 +255,17 @@ impl<'a> Reader<'a> {
     fn f64(&mut self) -> Result<f64, Short> {
         Ok(f64::from_bits(self.u64()?))
     }
-    fn i128(&mut self) -> Result<i128, Short> {
-        Ok(i128::from_le_bytes(
-            self.bytes(16)?.try_into().map_err(|_| Short)?,
-        ))
+    /// A varint written by [`put_varint`] (at most 19 bytes).
+    fn varint(&mut self) -> Result<i128, Short> {
+        let mut z: u128 = 0;
+        for shift in (0..133).step_by(7) {
+            let b = *self.bytes(1)?.first().ok_or(Short)?;
+            z |= u128::from(b & 0x7f).checked_shl(shift).ok_or(Short)?;
+            if b & 0x80 == 0 {
+                return Ok((z >> 1) as i128 ^ -((z & 1) as i128));
+            }
+        }
+        Err(Short)
     }
     /// A count, refused above `max` or above what the remaining bytes can hold.
     fn len(&mut self, max: u64) -> Result<usize, Short> {
@@ -282,7 +322,22 @@ fn write_film(out: &mut Vec<u8>, f: &FilmState) {
     put_u64(out, f.saturated);
     put_u64(out, f.sums.len() as u64);
     for s in &f.sums {
-        out.extend_from_slice(&s.to_le_bytes());
+        put_varint(out, *s);
+    }
+}
+
+/// A zigzag LEB128 varint: most sums are small multiples of 2⁻⁶⁴ units next
+/// to the i128 range, so this is 4–10 bytes instead of 16, before deflate.
+fn put_varint(out: &mut Vec<u8>, v: i128) {
+    let mut z = ((v << 1) ^ (v >> 127)) as u128;
+    loop {
+        let byte = (z & 0x7f) as u8;
+        z >>= 7;
+        if z == 0 {
+            out.push(byte);
+            return;
+        }
+        out.push(byte | 0x80);
     }
 }
 
@@ -326,11 +381,11 @@ fn read_film(r: &mut Reader<'_>) -> Result<FilmState, Short> {
     if n_sums != pixels.checked_mul(layout.state_stride()).ok_or(Short)? {
         return Err(Short);
     }
-    if r.b.len() - r.at < n_sums * 16 {
+    if r.b.len() - r.at < n_sums {
         return Err(Short);
     }
     let sums = (0..n_sums)
-        .map(|_| r.i128())
+        .map(|_| r.varint())
         .collect::<Result<Vec<_>, _>>()?;
     Ok(FilmState {
         layout,

@@ -1,4 +1,61 @@
-//! PCG32 random number generator [O'Neill 2014].
+//! Random numbers: the PCG32 generator [O'Neill 2014] and [`PathRng`], the
+//! one interface through which every path walk draws its uniform numbers.
+//!
+//! A walk is served either by the [`Sampler`] (camera-driven estimators:
+//! values are functions of pixel, sample index and dimension) or by a
+//! [`StreamRng`], a counter-based stream: PCG32 seeded by a hash of
+//! (seed, pass, index), so light path or photon `index` of `pass` draws the
+//! same numbers whatever thread traces it and in whatever order.
+
+use super::hash_u64s;
+use crate::math::Vec2;
+use crate::sampler::Sampler;
+
+/// Uniform numbers in [0, 1) for a path walk, one or two at a time.
+pub trait PathRng {
+    /// The next number.
+    fn u1(&mut self) -> f32;
+    /// The next two numbers (a 2D sample of the sampler).
+    fn u2(&mut self) -> Vec2;
+}
+
+impl PathRng for Sampler {
+    #[inline]
+    fn u1(&mut self) -> f32 {
+        self.get_1d()
+    }
+    #[inline]
+    fn u2(&mut self) -> Vec2 {
+        self.get_2d()
+    }
+}
+
+/// The numbers of path `index` of `pass`: PCG32 seeded by hash(seed, pass, index).
+#[derive(Clone, Debug)]
+pub struct StreamRng(Pcg32);
+
+impl StreamRng {
+    /// The stream of path `index` of `pass` under `seed`.
+    pub fn new(seed: u64, pass: u64, index: u64) -> Self {
+        Self(Pcg32::new(hash_u64s(&[seed, pass, index]), 0))
+    }
+    /// TEMPORARY: a stream from a precomputed hash.
+    pub fn with_hash(h: u64) -> Self {
+        Self(Pcg32::new(h, 0))
+    }
+}
+
+impl PathRng for StreamRng {
+    #[inline]
+    fn u1(&mut self) -> f32 {
+        self.0.uniform_f32()
+    }
+    #[inline]
+    fn u2(&mut self) -> Vec2 {
+        let x = self.0.uniform_f32();
+        Vec2::new(x, self.0.uniform_f32())
+    }
+}
 
 /// PCG-XSH-RR 64/32: small state, good statistics, seekable streams.
 #[derive(Clone, Debug)]

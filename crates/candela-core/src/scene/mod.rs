@@ -3,21 +3,22 @@
 
 mod motion;
 mod primitive;
+#[cfg(test)]
+mod tests;
 
 pub use motion::MovingGroup;
 pub use primitive::Primitive;
 
-use crate::accel::Bvh;
+use crate::accel::{Bvh, BvhHit};
 use crate::bsdf::Bsdf;
 use crate::camera::PixelFootprint;
 use crate::interaction::{Interaction, LightId, SurfaceInteraction};
 use crate::light::{Light, LightSampler};
 use crate::material::{mix_choice, Material};
 use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
-use crate::shape::WatertightRay;
+use crate::shape::{DeferredHit, WatertightRay};
 use crate::spectrum::SampledWavelengths;
 use crate::texture::TextureEvalContext;
-use rayon::prelude::*;
 
 /// Everything rays can hit or be lit by.
 pub struct Scene {
@@ -65,11 +66,9 @@ impl Scene {
         mut lights: Vec<Light>,
         power_sampling: bool,
     ) -> Self {
-        let mut prim_bounds: Vec<Bounds3> =
-            primitives.par_iter().map(|p| p.shape.bounds()).collect();
-        prim_bounds.extend(movers.iter().map(|m| m.bounds()));
-        let bounds = prim_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
-        let bvh = Bvh::build(&prim_bounds);
+        let mover_bounds: Vec<Bounds3> = movers.iter().map(|m| m.bounds()).collect();
+        let bvh = Primitive::bvh(&primitives, &mover_bounds);
+        let bounds = bvh.bounds();
         for l in &mut lights {
             l.preprocess(&bounds);
         }
@@ -104,6 +103,11 @@ impl Scene {
     /// The camera footprint, if set.
     pub fn footprint(&self) -> Option<&PixelFootprint> {
         self.footprint.as_ref()
+    }
+
+    /// Bytes held by the top-level BVH's nodes and triangle packs.
+    pub fn bvh_memory_bytes(&self) -> usize {
+        self.bvh.memory_bytes()
     }
 
     /// Bounds of all geometry.
@@ -160,25 +164,32 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let n = self.primitives.len() as u32;
         let wr = WatertightRay::new(ray);
-        let mut best = None;
-        self.bvh.intersect(ray, t_max, |i, ray, t_max| {
+        // The last hit the closure accepted: the closest one if an item the
+        // BVH does not pack wins.
+        let mut other = None;
+        let hit = self.bvh.intersect(ray, t_max, |i, ray, t_max| {
             if i >= n {
                 let (t, si) = self.movers[(i - n) as usize].intersect(ray, t_max)?;
-                best = Some(Err(si));
+                other = Some(Err(si));
                 return Some(t);
             }
             let hit = self.primitives[i as usize].hit(ray, &wr, t_max)?;
-            best = Some(Ok((i, hit)));
+            other = Some(Ok((i, hit)));
             Some(hit.t())
-        });
-        match best? {
-            Ok((i, hit)) => Some(self.finish(i, hit, ray)),
-            Err(si) => Some(si),
+        })?;
+        match hit {
+            BvhHit::Triangle { item, hit } => {
+                Some(self.finish(item, DeferredHit::Triangle(hit), ray))
+            }
+            BvhHit::Other { .. } => match other? {
+                Ok((i, hit)) => Some(self.finish(i, hit, ray)),
+                Err(si) => Some(si),
+            },
         }
     }
 
     /// The interaction of a static primitive's deferred hit.
-    fn finish(&self, i: u32, hit: crate::shape::DeferredHit, ray: &Ray) -> SurfaceInteraction {
+    fn finish(&self, i: u32, hit: DeferredHit, ray: &Ray) -> SurfaceInteraction {
         let prim = &self.primitives[i as usize];
         let mut si = prim.shape.finish_hit(hit, ray).si;
         si.material = prim.material;

@@ -11,10 +11,10 @@
 //! spawned from moving surfaces need no epsilon either.
 
 use super::Primitive;
-use crate::accel::Bvh;
+use crate::accel::{Bvh, BvhHit};
 use crate::interaction::SurfaceInteraction;
 use crate::math::{AnimatedTransform, Bounds3, Ray, Transform};
-use crate::shape::WatertightRay;
+use crate::shape::{DeferredHit, WatertightRay};
 
 /// Primitives moving together under one animated transform.
 #[derive(Debug)]
@@ -28,15 +28,15 @@ pub struct MovingGroup {
 impl MovingGroup {
     /// Primitives given in object space, placed by `render_from_object`.
     pub fn new(prims: Vec<Primitive>, render_from_object: AnimatedTransform) -> Self {
-        let prim_bounds: Vec<Bounds3> = prims.iter().map(|p| p.shape.bounds()).collect();
-        let object_bounds = prim_bounds.iter().fold(Bounds3::EMPTY, |a, b| a.union(*b));
+        let bvh = Primitive::bvh(&prims, &[]);
+        let object_bounds = bvh.bounds();
         let bounds = if object_bounds.is_empty() {
             object_bounds
         } else {
             render_from_object.motion_bounds(&object_bounds)
         };
         Self {
-            bvh: Bvh::build(&prim_bounds),
+            bvh,
             prims,
             render_from_object,
             bounds,
@@ -137,15 +137,18 @@ fn closest_hit(
     bvh: &Bvh,
     ray: &Ray,
     t_max: f32,
-) -> Option<(u32, crate::shape::DeferredHit)> {
-    let mut best = None;
+) -> Option<(u32, DeferredHit)> {
+    let mut other = None;
     let wr = WatertightRay::new(ray);
-    bvh.intersect(ray, t_max, |i, ray, t_max| {
+    let hit = bvh.intersect(ray, t_max, |i, ray, t_max| {
         let hit = prims[i as usize].hit(ray, &wr, t_max)?;
-        best = Some((i, hit));
+        other = Some((i, hit));
         Some(hit.t())
-    });
-    best
+    })?;
+    match hit {
+        BvhHit::Triangle { item, hit } => Some((item, DeferredHit::Triangle(hit))),
+        BvhHit::Other { .. } => other,
+    }
 }
 
 /// True if any primitive in `prims` blocks the ray, honouring alpha cut-outs.

@@ -17,6 +17,29 @@ pub struct Primitive {
 }
 
 impl Primitive {
+    /// The vertices of an opaque mesh triangle, which the BVH stores and
+    /// tests itself; `None` for anything the primitive must test (other
+    /// shapes, alpha cut-outs).
+    #[inline]
+    pub fn packed_triangle(&self) -> Option<[crate::math::Vec3; 3]> {
+        match (&self.shape, &self.alpha) {
+            (crate::shape::Shape::Triangle(t), None) => Some(t.positions()),
+            _ => None,
+        }
+    }
+
+    /// A BVH over `prims` followed by `extra` items of the given bounds
+    /// (item `prims.len() + k` is `extra[k]`); opaque triangles go into its
+    /// packs.
+    pub fn bvh(prims: &[Primitive], extra: &[crate::math::Bounds3]) -> crate::accel::Bvh {
+        use rayon::prelude::*;
+        let mut bounds: Vec<_> = prims.par_iter().map(|p| p.shape.bounds()).collect();
+        bounds.extend_from_slice(extra);
+        crate::accel::Bvh::build_with_triangles(&bounds, |i| {
+            prims.get(i as usize).and_then(Primitive::packed_triangle)
+        })
+    }
+
     /// Closest-hit candidate before `t_max` that survives the alpha test.
     #[inline]
     pub fn hit(

@@ -12,9 +12,16 @@
 //! (pa − o)·(d × (pb − pa)) = 0, a quadratic a + bu + cu² in u. Each root
 //! in [0, 1] gives the closest points of the two lines, hence t and v. We
 //! evaluate it in double precision: pbrt-v4 leaves the rounding error of t
-//! unbounded ("TODO: reject hits with sufficiently small t"), and in f64
-//! the error of a root is far below the offset of a spawned ray, so rays
-//! leaving the surface do not re-hit it. Roots within 1e-9 of the patch's
+//! unbounded ("TODO: reject hits with sufficiently small t"). In f64 the
+//! error of t is about 2⁻⁵³·|pa|/|d| (pa: the operand from the ray origin to
+//! the patch), far below the offset of a spawned ray, which moves the origin
+//! by at least one f32 ulp (2⁻²⁴ relative) off the surface, so roots with
+//! t ≤ 10⁻¹⁰·|pa|/|d| are rejected as the origin's own surface. That offset
+//! is zero where the patch lies in a coordinate plane (its corners' error
+//! bound vanishes there), so a ray leaving such a patch starts exactly on it
+//! and, without the bound, re-hit it at t ≈ 10⁻¹⁷ forever (an `interface`
+//! floor at y = 0 hung the path tracer, which does not count crossings of
+//! material-less surfaces as bounces). Roots within 1e-9 of the patch's
 //! parameter edges are accepted and clamped, so a ray through the edge shared
 //! by two patches cannot slip between them.
 //!
@@ -44,6 +51,9 @@ pub struct BilinearIntersection {
     /// Ray parameter.
     pub t: f32,
 }
+
+/// Relative rounding bound of a root's t (module docs).
+const T_EPS: f64 = 1e-10;
 
 /// Closest hit of `ray` with the patch `[p00, p10, p01, p11]` for
 /// `t ∈ (0, t_max)` [Reshetov 2019].
@@ -82,7 +92,8 @@ pub fn intersect_bilinear_patch(
         let m = n.cross(pa);
         let (t, v) = (m.dot(pb) / det, m.dot(d) / det);
         let v_ok = (-EDGE_EPS..=1.0 + EDGE_EPS).contains(&v);
-        if v_ok && t > 0.0 && best.is_none_or(|(tb, _, _)| t < tb) {
+        let t_min = T_EPS * pa.length() / d.length();
+        if v_ok && t > t_min && best.is_none_or(|(tb, _, _)| t < tb) {
             best = Some((t, u, v));
         }
     }

@@ -408,3 +408,41 @@ fn texture_coordinates_reparameterise_the_derivatives() {
     assert!(h.si.dpdv.as_dvec3().distance(-0.5 * dpdu) < 1e-3);
     assert!(h.si.n().as_dvec3().dot(dpdu.cross(dpdv)) > 0.0);
 }
+
+/// A patch in the plane y = 0 has a zero error bound along y, so a ray
+/// spawned from a hit starts exactly on it; it must not hit the patch again
+/// (it did at t ≈ 1e-17, which hung the path tracer on an `interface`
+/// floor: findings/interface-material-hang.pbrt).
+#[test]
+fn a_ray_spawned_from_a_patch_in_a_coordinate_plane_does_not_rehit_it() {
+    let floor = [
+        Vec3::new(-5.0, 0.0, -5.0),
+        Vec3::new(5.0, 0.0, -5.0),
+        Vec3::new(-5.0, 0.0, 5.0),
+        Vec3::new(5.0, 0.0, 5.0),
+    ];
+    let shape = bilinear(floor, false, None, None);
+    let mut r = Pcg32::new(7, 1);
+    let mut crossings = 0;
+    for _ in 0..2000 {
+        let o = Vec3::new(0.0, 1.5, -4.0);
+        let target = Vec3::new(
+            8.0 * r.uniform_f32() - 4.0,
+            0.0,
+            8.0 * r.uniform_f32() - 4.0,
+        );
+        let Some(h) = shape.intersect(&Ray::new(o, target - o), f32::INFINITY) else {
+            continue;
+        };
+        // Straight on through the surface, as an interface crossing does.
+        let through = h.si.spawn_ray((target - o).normalize());
+        assert!(
+            shape.intersect(&through, f32::INFINITY).is_none(),
+            "re-hit from {:?} along {:?}",
+            through.o,
+            through.d
+        );
+        crossings += 1;
+    }
+    assert!(crossings > 1000, "{crossings}");
+}

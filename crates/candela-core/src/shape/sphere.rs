@@ -63,9 +63,11 @@ impl Sphere {
         z_max: f32,
         phi_max_deg: f32,
     ) -> Self {
+        // The builder refuses radii that are not positive; `max`/`min`
+        // rather than `clamp` keep a bad one from panicking here.
         let (lo, hi) = (z_min.min(z_max), z_min.max(z_max));
-        let z_min = lo.clamp(-radius, radius);
-        let z_max = hi.clamp(-radius, radius);
+        let z_min = lo.max(-radius).min(radius);
+        let z_max = hi.max(-radius).min(radius);
         let det = Mat3::from_mat4(render_from_object.m).determinant();
         Self {
             reverse_orientation,

@@ -69,6 +69,14 @@ impl WatertightRay {
         }
     }
 
+    /// The ray origin, the axis permutation `[kx, ky, kz]` (`kz` the dominant
+    /// axis) and the shear `(-dx/dz, -dy/dz, 1/dz)`, for batched tests that
+    /// must round exactly as [`Self::intersect`] does.
+    #[inline]
+    pub(crate) fn parts(&self) -> (Vec3, [usize; 3], Vec3) {
+        (self.o, self.k, self.s)
+    }
+
     /// Watertight ray–triangle test; `None` unless the hit has `t ∈ (0, t_max)`
     /// conservatively [Woop et al. 2013; pbrt-v4 §6.5.3].
     #[inline]

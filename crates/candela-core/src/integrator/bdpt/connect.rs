@@ -13,14 +13,16 @@
 //! f̂_L = f·|ωo·ns||ωi·ng|/|ωo·ng| is the light-side BSDF with the adjoint
 //! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
 
+use super::density::{emitted, pdf_light_origin};
 use super::mis::{mis_weight, MisHeuristic, PathDensities, PathView};
-use super::vertex::{emitted, pdf_light_origin, Vertex, VertexKind};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
-use crate::interaction::Interaction;
-use crate::light::{LightSampleContext, LightType};
-use crate::math::{Vec2, Vec3};
+use crate::integrator::nee::{sample_light, Receiver};
+use crate::integrator::subpath::{Vertex, VertexKind};
+use crate::light::LightType;
+use crate::math::Vec2;
 use crate::sampler::Sampler;
+use crate::sampling::PdfArea;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use std::cell::RefCell;
@@ -169,7 +171,7 @@ fn connect_camera<'a>(
                 return None;
             }
             let cs = cx.camera.sample_wi(&v.it, u)?;
-            (light_side_f(v, cs.wi), cs)
+            (v.f_adjoint_cos(cs.wi), cs)
         }
     };
     let (f, cs) = f_hat;
@@ -181,7 +183,7 @@ fn connect_camera<'a>(
         return None;
     }
     let mut lens = Vertex::camera(cs.p_lens, SampledSpectrum::splat(cs.we / cs.pdf.0));
-    lens.pdf_fwd = 0.0;
+    lens.pdf_fwd = PdfArea(0.0);
     let view = PathView {
         light,
         cam,
@@ -193,7 +195,7 @@ fn connect_camera<'a>(
     Some(((c, Some(cs.p_raster)), view))
 }
 
-/// s = 1: next-event estimation from camera vertex t − 1.
+/// s = 1: next-event estimation from camera vertex t − 1 ([`sample_light`]).
 fn connect_light<'a>(
     cx: &ConnectCtx<'_>,
     light: &'a [Vertex],
@@ -202,40 +204,14 @@ fn connect_light<'a>(
     sampler: &mut Sampler,
 ) -> Option<(Unweighted, PathView<'a>)> {
     let v = &cam[t - 1];
-    let (u_light, u) = (sampler.get_1d(), sampler.get_2d());
-    let bsdf = v.bsdf.as_ref()?;
-    if !bsdf.flags().is_non_specular() {
+    let r = Receiver::at_vertex(v)?;
+    let ls = sample_light(cx.scene, &r, cx.lambda, sampler)?;
+    let c = v.beta * ls.f_cos * ls.li / (ls.pmf * ls.pdf.0);
+    if c.is_black() {
         return None;
     }
-    let (id, p_light) = cx.scene.light_sampler().sample(u_light)?;
-    let l = cx.scene.light(id);
-    let ctx = LightSampleContext {
-        p: v.it.p,
-        p_error: v.it.p_error,
-        n: v.it.n,
-        ns: v.ns,
-    };
-    let ls = l.sample_li(&ctx, u, cx.lambda)?;
-    if ls.l.is_black() || ls.pdf.0 == 0.0 {
-        return None;
-    }
-    let f = bsdf.f(v.wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(v.ns).abs();
-    let c = v.beta * f * ls.l / (p_light * ls.pdf.0);
-    if c.is_black() || !cx.scene.unoccluded(&v.it, &ls.p_light) {
-        return None;
-    }
-    let at_inf = matches!(
-        l.light_type(),
-        LightType::Infinite | LightType::DeltaDirection
-    );
-    let w_inf = if at_inf { -ls.wi } else { Vec3::ZERO };
-    let it = if ls.p_light.is_surface() || at_inf {
-        ls.p_light
-    } else {
-        Interaction::at_point(ls.p_light.p)
-    };
-    let mut e = Vertex::light(id, it, w_inf, SampledSpectrum::zero());
-    e.pdf_fwd = pdf_light_origin(cx.scene, &e, v);
+    let mut e = ls.vertex(cx.scene);
+    e.pdf_fwd = PdfArea(pdf_light_origin(cx.scene, &e, v));
     let view = PathView {
         light,
         cam,
@@ -267,7 +243,7 @@ fn connect_inner<'a>(
     }
     let w = d / d2.sqrt();
     let f_cam = cb.f(cv.wo, -w, TransportMode::Radiance) * w.dot(cv.ns).abs();
-    let c = lv.beta * light_side_f(lv, w) * f_cam * cv.beta / d2;
+    let c = lv.beta * lv.f_adjoint_cos(w) * f_cam * cv.beta / d2;
     if c.is_black() || !cx.scene.unoccluded(&lv.it, &cv.it) {
         return None;
     }
@@ -280,17 +256,4 @@ fn connect_inner<'a>(
         cam_end: None,
     };
     Some(((c, None), view))
-}
-
-/// f̂ = f·|ωo·ns||ωi·ng|/|ωo·ng| at a light-subpath surface vertex scattering towards `wi`.
-fn light_side_f(v: &Vertex, wi: Vec3) -> SampledSpectrum {
-    let Some(bsdf) = &v.bsdf else {
-        return SampledSpectrum::zero();
-    };
-    let den = v.wo.dot(v.it.n).abs();
-    if den == 0.0 {
-        return SampledSpectrum::zero();
-    }
-    bsdf.f(v.wo, wi, TransportMode::Importance)
-        * (v.wo.dot(v.ns).abs() * wi.dot(v.it.n).abs() / den)
 }

@@ -16,9 +16,10 @@
 //! The densities next to the connection are unknown to either subpath and
 //! are computed here; all others were stored by the random walks.
 
-use super::vertex::{pdf, pdf_light_origin, Vertex};
+use super::density::{pdf, pdf_light_origin};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
+use crate::integrator::subpath::Vertex;
 use crate::light::LightType;
 use crate::scene::Scene;
 
@@ -118,11 +119,11 @@ impl PathDensities {
         for i in 0..n {
             let v = view.get(i);
             if i < s {
-                p_light.push(v.pdf_fwd);
-                p_eye.push(v.pdf_rev);
+                p_light.push(v.pdf_fwd.0);
+                p_eye.push(v.pdf_rev.0);
             } else {
-                p_light.push(v.pdf_rev);
-                p_eye.push(v.pdf_fwd);
+                p_light.push(v.pdf_rev.0);
+                p_eye.push(v.pdf_fwd.0);
             }
             delta.push(v.delta && i + 1 != s && i != s);
         }

@@ -19,10 +19,10 @@
 //! deterministic splat lanes and are averaged over the passes.
 
 mod connect;
+mod density;
 mod mis;
 #[cfg(test)]
 mod tests;
-mod vertex;
 mod visualize;
 mod walk;
 

@@ -10,12 +10,13 @@
 //! p_s^β / Σ p_k^β computed in f64.
 
 use super::connect::{strategy, ConnectCtx};
+use super::density::{pdf, pdf_light_origin};
 use super::mis::{strategy_valid, weight_from_densities, MisHeuristic, PathDensities, PathView};
-use super::vertex::{pdf, pdf_light_origin, Vertex, VertexKind};
 use super::walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
 use crate::bsdf::TransportMode;
 use crate::build::{build, Overrides, RenderSetup};
 use crate::camera::CameraSample;
+use crate::integrator::subpath::{Vertex, VertexKind};
 use crate::math::{UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::spectrum::SampledWavelengths;

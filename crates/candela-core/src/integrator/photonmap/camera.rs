@@ -1,23 +1,25 @@
-//! The camera side of photon mapping: the specular camera path, direct
-//! light, the caustic lookup and final gathering (partition in the parent
-//! module's doc).
+//! The camera side of photon mapping: the specular camera path with its
+//! direct light (the shared camera walk, [`crate::integrator::camera_walk`]),
+//! the caustic lookup and final gathering (partition in the parent module's
+//! doc).
 
 use super::maps::{Lookup, PassMaps, Query};
 use super::PhotonMapSettings;
-use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
-use crate::integrator::direct::light_sampled_direct;
-use crate::interaction::SurfaceInteraction;
-use crate::math::{Ray, Vec3};
+use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
+use crate::integrator::camera_walk::{camera_walk, CameraWalk};
+use crate::integrator::subpath::{walk, Dispersion, Flow, Start, Vertex, Visitor, Walk};
+use crate::math::Ray;
 use crate::sampler::Sampler;
+use crate::sampling::{PathRng, PdfSolidAngle};
 use crate::scene::Scene;
 use crate::spatial::Neighbor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Everything a camera sample of one pass reads.
-pub struct CameraWalk<'a> {
+pub struct CameraSide<'a> {
     /// The scene.
     pub scene: &'a Scene,
-    /// The pass's photon maps.
+    /// The photon maps of the pixel's wavelength group.
     pub maps: &'a PassMaps,
     /// Integrator settings.
     pub settings: &'a PhotonMapSettings,
@@ -27,95 +29,65 @@ pub struct CameraWalk<'a> {
     pub caustic_lookup: Lookup,
 }
 
-/// A non-specular vertex of the camera path (or of a gather ray).
-struct Vertex<'a> {
-    si: &'a SurfaceInteraction,
-    bsdf: &'a Bsdf,
-    wo: Vec3,
-    /// Scattering events up to and including this vertex.
-    depth: u32,
-}
-
-impl CameraWalk<'_> {
+impl CameraSide<'_> {
     /// Radiance arriving along the camera ray `ray` at the pass wavelengths.
     pub fn li(
         &self,
-        mut ray: Ray,
+        ray: Ray,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         scratch: &mut Vec<Neighbor>,
     ) -> SampledSpectrum {
-        let scene = self.scene;
+        let cw = CameraWalk {
+            max_depth: self.settings.max_depth,
+            emission_beyond: true,
+        };
         let mut l = SampledSpectrum::zero();
-        let mut beta = SampledSpectrum::one();
-        let mut depth = 0;
-        loop {
-            let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
-                // Only delta lobes led here: no other estimator sees this light.
-                for &id in scene.infinite_lights() {
-                    l += beta * scene.light(id).le(&ray, lambda);
-                }
-                break;
-            };
-            if let Some(id) = si.area_light {
-                l += beta * scene.light(id).l(si.p(), si.n(), si.it.uv, si.wo, lambda);
-            }
-            let Some(bsdf) = scene.bsdf(&mut si, lambda) else {
-                ray = si.spawn_ray(ray.d);
-                continue;
-            };
-            if depth == self.settings.max_depth {
-                break;
-            }
-            depth += 1;
-            let wo = si.wo;
-            if bsdf.flags().is_non_specular() {
-                let v = Vertex {
-                    si: &si,
-                    bsdf: &bsdf,
-                    wo,
-                    depth,
-                };
-                l += beta * self.shade(&v, lambda, sampler, scratch);
-            }
-            let Some(bs) = sample_delta(&bsdf, wo, sampler) else {
-                break;
-            };
-            beta *= throughput(&bsdf, &bs);
-            ray = si.spawn_ray(bs.wi);
-        }
-        l
+        let one = SampledSpectrum::one();
+        let direct = camera_walk(
+            self.scene,
+            ray,
+            one,
+            lambda,
+            sampler,
+            &cw,
+            |v, bsdf, lam, s| {
+                l += v.beta * self.shade(v, bsdf, lam, s, scratch);
+                Flow::SpecularOnly
+            },
+        );
+        direct + l
     }
 
-    /// Direct + caustic + indirect light reflected at a non-specular camera vertex.
+    /// Caustic + indirect light reflected at a non-specular camera vertex.
     fn shade(
         &self,
-        v: &Vertex<'_>,
+        v: &Vertex,
+        bsdf: &Bsdf,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         scratch: &mut Vec<Neighbor>,
     ) -> SampledSpectrum {
-        let direct = light_sampled_direct(self.scene, v.si, v.bsdf, v.wo, lambda, sampler);
+        let q = self.query(v, bsdf);
         let caustic = self
             .maps
             .caustic
-            .radiance(&self.query(v), &self.caustic_lookup, scratch);
+            .radiance(&q, &self.caustic_lookup, scratch);
         let indirect = if self.settings.final_gather {
-            self.final_gather(v, lambda, sampler, scratch)
+            self.final_gather(v, bsdf, lambda, sampler, scratch)
         } else {
-            self.maps
-                .global
-                .radiance(&self.query(v), &self.global_lookup, scratch)
+            self.maps.global.radiance(&q, &self.global_lookup, scratch)
         };
-        direct + caustic + indirect
+        caustic + indirect
     }
 
     /// A lookup at `v` admitting photons that keep the path within `maxdepth`.
-    fn query<'v>(&self, v: &Vertex<'v>) -> Query<'v> {
+    fn query<'v>(&self, v: &'v Vertex, bsdf: &'v Bsdf) -> Query<'v> {
         Query {
-            si: v.si,
-            bsdf: v.bsdf,
+            p: v.p(),
+            n: v.it.n,
             wo: v.wo,
+            bsdf,
             // j + d − 1 ≤ maxdepth for a photon at its d-th hit read at vertex j.
             max_photon_depth: self.settings.max_depth + 1 - v.depth,
         }
@@ -126,18 +98,28 @@ impl CameraWalk<'_> {
     /// final gathering].
     fn final_gather(
         &self,
-        v: &Vertex<'_>,
+        v: &Vertex,
+        bsdf: &Bsdf,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         scratch: &mut Vec<Neighbor>,
     ) -> SampledSpectrum {
         let n = self.settings.gather_rays;
-        let mut sum = SampledSpectrum::zero();
+        let w = Walk {
+            mode: TransportMode::Radiance,
+            max_depth: self.settings.max_depth,
+            roulette: None,
+            regularize: false,
+            dispersion: Dispersion::Keep,
+        };
+        let mut gather = Gather {
+            side: self,
+            l: SampledSpectrum::zero(),
+            scratch,
+        };
         for _ in 0..n {
-            let (uc, u) = (sampler.get_1d(), sampler.get_2d());
-            let Some(bs) = v
-                .bsdf
-                .sample_f(v.wo, uc, u, TransportMode::Radiance, SampleFlags::ALL)
+            let (uc, u) = (sampler.u1(), sampler.u2());
+            let Some(bs) = bsdf.sample_f(v.wo, uc, u, TransportMode::Radiance, SampleFlags::ALL)
             else {
                 continue;
             };
@@ -145,80 +127,44 @@ impl CameraWalk<'_> {
             if bs.is_specular() {
                 continue;
             }
-            let beta = throughput(v.bsdf, &bs);
-            let ray = v.si.spawn_ray(bs.wi);
-            sum += beta * self.gather_ray(ray, v.depth, lambda, sampler, scratch);
+            let start = Start {
+                ray: v.it.spawn_ray(bs.wi),
+                beta: bs.f * (bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0),
+                depth: v.depth,
+                from: None,
+                pdf_dir: PdfSolidAngle(0.0),
+            };
+            walk(self.scene, lambda, sampler, &w, start, &mut gather);
         }
         if n == 0 {
-            sum
+            gather.l
         } else {
-            sum / n as f32
+            gather.l / n as f32
         }
     }
+}
 
-    /// Radiance reflected towards a gather ray's origin, emission excluded:
-    /// the global map at the first non-specular vertex, through delta lobes.
-    fn gather_ray(
-        &self,
-        mut ray: Ray,
-        mut depth: u32,
-        lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
-        scratch: &mut Vec<Neighbor>,
-    ) -> SampledSpectrum {
-        let scene = self.scene;
-        let mut l = SampledSpectrum::zero();
-        let mut beta = SampledSpectrum::one();
-        while let Some(mut si) = scene.intersect(&ray, f32::INFINITY) {
-            let Some(bsdf) = scene.bsdf(&mut si, lambda) else {
-                ray = si.spawn_ray(ray.d);
-                continue;
-            };
-            if depth == self.settings.max_depth {
-                break;
-            }
-            depth += 1;
-            let wo = si.wo;
+/// The visitor of gather rays: the global map at every vertex with a
+/// non-specular lobe (emission excluded), through delta lobes.
+struct Gather<'a, 'b> {
+    side: &'a CameraSide<'b>,
+    l: SampledSpectrum,
+    scratch: &'a mut Vec<Neighbor>,
+}
+
+impl Visitor<Sampler> for Gather<'_, '_> {
+    fn vertex(&mut self, v: &Vertex, _: &mut SampledWavelengths, _: &mut Sampler) -> Flow {
+        if let Some(bsdf) = &v.bsdf {
             if bsdf.flags().is_non_specular() {
-                let v = Vertex {
-                    si: &si,
-                    bsdf: &bsdf,
-                    wo,
-                    depth,
-                };
-                l += beta
-                    * self
-                        .maps
-                        .global
-                        .radiance(&self.query(&v), &self.global_lookup, scratch);
+                let q = self.side.query(v, bsdf);
+                let side = self.side;
+                let e = side
+                    .maps
+                    .global
+                    .radiance(&q, &side.global_lookup, self.scratch);
+                self.l += v.beta * e;
             }
-            let Some(bs) = sample_delta(&bsdf, wo, sampler) else {
-                break;
-            };
-            beta *= throughput(&bsdf, &bs);
-            ray = si.spawn_ray(bs.wi);
         }
-        l
+        Flow::SpecularOnly
     }
-}
-
-/// Samples `bsdf` and keeps the sample only if it chose a delta lobe (the
-/// estimate of the delta part alone: non-delta samples count zero).
-fn sample_delta(bsdf: &Bsdf, wo: Vec3, sampler: &mut Sampler) -> Option<BsdfSample> {
-    if !bsdf.flags().is_specular() {
-        return None;
-    }
-    let bs = bsdf.sample_f(
-        wo,
-        sampler.get_1d(),
-        sampler.get_2d(),
-        TransportMode::Radiance,
-        SampleFlags::ALL,
-    )?;
-    bs.is_specular().then_some(bs)
-}
-
-/// f·|cos θ|/p of a BSDF sample.
-fn throughput(bsdf: &Bsdf, bs: &BsdfSample) -> SampledSpectrum {
-    bs.f * (bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0)
 }

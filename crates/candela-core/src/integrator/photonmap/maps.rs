@@ -52,7 +52,6 @@
 use super::PhotonMapSettings;
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
-use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
 use crate::sampling::hash_u64s;
 use crate::scene::Scene;
@@ -138,7 +137,9 @@ pub struct PhotonMap {
 /// A camera-side point where a map is read.
 pub struct Query<'a> {
     /// The surface point.
-    pub si: &'a SurfaceInteraction,
+    pub p: Vec3,
+    /// Its geometric normal.
+    pub n: Vec3,
     /// Its BSDF.
     pub bsdf: &'a Bsdf,
     /// Direction towards the viewer.
@@ -182,7 +183,7 @@ impl PhotonMap {
         }
         let r2 = self
             .tree
-            .k_nearest(q.si.p(), lookup.k, lookup.max_radius, scratch);
+            .k_nearest(q.p, lookup.k, lookup.max_radius, scratch);
         if scratch.is_empty() || r2.is_nan() || r2 <= 0.0 {
             return SampledSpectrum::zero();
         }
@@ -190,7 +191,7 @@ impl PhotonMap {
         let skip = (scratch.len() >= lookup.k)
             .then(|| scratch.iter().max().map(|n| n.index))
             .flatten();
-        let (ns, ng) = (q.bsdf.ns(), q.si.n());
+        let (ns, ng) = (q.bsdf.ns(), q.n);
         let mut sum = SampledSpectrum::zero();
         for n in scratch.iter().filter(|n| Some(n.index) != skip) {
             let ph = &self.tree.items()[n.index as usize];
@@ -239,8 +240,8 @@ impl Keep {
     fn keeps(self, h: &PhotonHit<'_>) -> bool {
         match self {
             Keep::All => true,
-            Keep::Indirect => h.depth >= 2 && !h.caustic,
-            Keep::Caustic => h.caustic,
+            Keep::Indirect => h.v.depth >= 2 && !h.v.caustic,
+            Keep::Caustic => h.v.caustic,
         }
     }
 }
@@ -313,11 +314,11 @@ pub fn shoot_map(
                 trace_photon(scene, lambda, settings, pass, i, |h| {
                     if keep.keeps(h) {
                         out.push(Photon {
-                            p: h.si.p(),
-                            wi: h.si.wo,
-                            n: h.si.n(),
-                            power: h.beta * inv_n,
-                            depth: h.depth,
+                            p: h.v.p(),
+                            wi: h.v.wo,
+                            n: h.v.it.n,
+                            power: h.v.beta * inv_n,
+                            depth: h.v.depth,
                         });
                     }
                 });
@@ -332,6 +333,7 @@ pub fn shoot_map(
 mod tests {
     use super::*;
     use crate::bsdf::{Bxdf, DiffuseBxdf};
+    use crate::interaction::SurfaceInteraction;
     use crate::math::Frame;
     use crate::math::{Vec2, Vec3};
     use crate::sampling::{sample_cosine_hemisphere, sample_uniform_sphere, Pcg32};
@@ -398,7 +400,8 @@ mod tests {
             Bxdf::Diffuse(DiffuseBxdf::new(SampledSpectrum::splat(1.0))),
         );
         let query = Query {
-            si: &si,
+            p: si.p(),
+            n: si.n(),
             bsdf: &bsdf,
             wo: n,
             max_photon_depth: 1,

@@ -75,7 +75,7 @@ use crate::film::{FilmTile, PassBlock};
 use crate::math::UVec2;
 use crate::sampling::{hash_u64s, Pcg32};
 use crate::spectrum::SampledWavelengths;
-use camera::CameraWalk;
+use camera::CameraSide;
 use maps::PassMaps;
 
 /// Default `maxradius` as a fraction of the scene's bounding-sphere radius.
@@ -154,7 +154,7 @@ impl Integrator for PhotonMapIntegrator {
         let lambda = pass_wavelengths(self.settings.seed, pass as u32, passes);
         let maps = PassMaps::shoot(ctx.scene, &lambda, &self.settings, pass);
         ctx.advance(self.settings.photons + self.settings.caustic_photons);
-        let walk = CameraWalk {
+        let walk = CameraSide {
             scene: ctx.scene,
             maps: &maps,
             settings: &self.settings,
@@ -201,7 +201,7 @@ pub fn pass_wavelengths(seed: u64, pass: u32, passes: u32) -> SampledWavelengths
 /// Renders one camera sample per pixel for `pass`, tile by tile in parallel;
 /// the tiles come back in scanline order (`None` if cancelled).
 fn render_pass(
-    walk: &CameraWalk<'_>,
+    walk: &CameraSide<'_>,
     ctx: &RenderContext<'_>,
     pass: u32,
     lambda: &SampledWavelengths,

@@ -1,11 +1,12 @@
 //! The two passes every progressive photon-mapping iteration makes
 //! [Hachisuka, Ogaki & Jensen 2008; Hachisuka & Jensen 2009; pbrt-v3/v4 SPPM]:
 //!
-//! 1. `camera_pass`: one camera path per pixel follows specular (and, before
+//! 1. `camera_pass`: one camera path per pixel (the shared camera walk,
+//!    [`crate::integrator::camera_walk`]) follows specular (and, before
 //!    the last bounce, glossy) scattering, adds emission seen directly or
 //!    through specular chains and next-event direct lighting at every
 //!    non-specular vertex, and stops at the first diffuse vertex (or a glossy
-//!    one at depth maxdepth − 1), which becomes the pixel's *visible point*.
+//!    one at depth maxdepth), which becomes the pixel's *visible point*.
 //! 2. `photon_pass`: photons from [`crate::integrator::photon`] that reach a
 //!    surface after at least one bounce (direct light is the camera pass's
 //!    job) add β·f(x, ωp → ωo) to every visible point whose sphere contains
@@ -25,11 +26,12 @@
 //! stays spectral until the pixel update converts it. Photon chunks return
 //! their contributions as lists merged in chunk order: deterministic.
 
-use crate::bsdf::{Bsdf, BxdfFlags, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, BxdfFlags, TransportMode};
 use crate::film::Film;
-use crate::integrator::direct::light_sampled_direct;
+use crate::integrator::camera_walk::{camera_walk, CameraWalk};
 use crate::integrator::driver::camera_sample;
 use crate::integrator::photon::{trace_photon, ShootSettings};
+use crate::integrator::subpath::Flow;
 use crate::integrator::RenderContext;
 use crate::math::{UVec2, Vec3};
 use crate::sampler::Sampler;
@@ -105,6 +107,8 @@ pub fn camera_pass(
     Some(chunks?.into_iter().flatten().collect())
 }
 
+/// The camera walk of one pixel: direct light on the way and the visible
+/// point at the first diffuse vertex (or a glossy one at `max_depth`).
 fn visit_pixel(
     ctx: &RenderContext<'_>,
     pixel: UVec2,
@@ -120,63 +124,37 @@ fn visit_pixel(
     let Some(cs) = camera_sample(ctx, pixel, sampler) else {
         return visit;
     };
-    let scene = ctx.scene;
-    let mut lam = *lambda;
-    let mut ld = SampledSpectrum::zero();
-    let mut beta = SampledSpectrum::splat(cs.ray_weight);
-    let mut ray = cs.ray;
-    let mut specular = true;
-    let mut depth = 0;
-    while depth < max_depth {
-        let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
-            if specular {
-                for &id in scene.infinite_lights() {
-                    ld += beta * scene.light(id).le(&ray, &lam);
-                }
+    let cw = CameraWalk {
+        max_depth,
+        emission_beyond: false,
+    };
+    let beta = SampledSpectrum::splat(cs.ray_weight);
+    let mut vp = None;
+    visit.ld = camera_walk(
+        ctx.scene,
+        cs.ray,
+        beta,
+        &mut visit.lambda,
+        sampler,
+        &cw,
+        |v, bsdf, lam, _| {
+            let flags = bsdf.flags();
+            let glossy_last = flags.contains(BxdfFlags::GLOSSY) && v.depth == max_depth;
+            if !flags.contains(BxdfFlags::DIFFUSE) && !glossy_last {
+                return Flow::Continue;
             }
-            break;
-        };
-        if specular {
-            if let Some(id) = si.area_light {
-                ld += beta * scene.light(id).l(si.p(), si.n(), si.it.uv, si.wo, &lam);
-            }
-        }
-        let Some(bsdf) = scene.bsdf(&mut si, &mut lam) else {
-            ray = si.spawn_ray(ray.d);
-            continue;
-        };
-        let flags = bsdf.flags();
-        if flags.is_non_specular() {
-            ld += beta * light_sampled_direct(scene, &si, &bsdf, si.wo, &lam, sampler);
-        }
-        let glossy_last = flags.contains(BxdfFlags::GLOSSY) && depth + 1 == max_depth;
-        if flags.contains(BxdfFlags::DIFFUSE) || glossy_last {
-            visit.vp = Some(VisiblePoint {
-                p: si.p(),
-                wo: si.wo,
-                n: si.n(),
-                bsdf,
-                beta,
+            vp = Some(VisiblePoint {
+                p: v.p(),
+                wo: v.wo,
+                n: v.it.n,
+                bsdf: *bsdf,
+                beta: v.beta,
                 terminated: lam.secondary_terminated(),
             });
-            break;
-        }
-        let Some(bs) = bsdf.sample_f(
-            si.wo,
-            sampler.get_1d(),
-            sampler.get_2d(),
-            TransportMode::Radiance,
-            SampleFlags::ALL,
-        ) else {
-            break;
-        };
-        beta *= bs.f * (bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0);
-        specular = bs.is_specular();
-        ray = si.spawn_ray(bs.wi);
-        depth += 1;
-    }
-    visit.ld = ld;
-    visit.lambda = lam;
+            Flow::Stop
+        },
+    );
+    visit.vp = vp;
     visit
 }
 
@@ -234,20 +212,20 @@ pub fn photon_pass(
             let mut out = Vec::new();
             for i in c * CHUNK..((c + 1) * CHUNK).min(n_photons) {
                 trace_photon(scene, lambda, shoot, pass, i, |h| {
-                    if h.depth < 2 {
+                    if h.v.depth < 2 {
                         return; // direct light: the camera pass's NEE
                     }
-                    grid.for_each_containing(h.si.p(), |j| {
+                    grid.for_each_containing(h.v.p(), |j| {
                         let Some(vp) = &visits[j as usize].vp else {
                             return;
                         };
-                        let n_p = h.si.n();
+                        let n_p = h.v.it.n;
                         if n_p.dot(vp.n) <= 0.0 {
                             return;
                         }
-                        let wi = rotate_between(h.si.wo, n_p, vp.n);
+                        let wi = rotate_between(h.v.wo, n_p, vp.n);
                         let f = vp.bsdf.f(vp.wo, wi, TransportMode::Radiance);
-                        let mut phi = h.beta * f;
+                        let mut phi = h.v.beta * f;
                         if vp.terminated {
                             phi = hero_only(phi, h.terminated);
                         }

@@ -34,6 +34,14 @@ fn areas(geo: Geo, l: f32, two_sided: bool) -> Vec<Light> {
 
 /// One light of every type and shape, with its closed-form Φ.
 fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
+    let mut v = punctual_lights_with_phi();
+    v.extend(area_lights_with_phi());
+    v
+}
+
+/// Area lights and their closed-form Φ.
+fn area_lights_with_phi() -> Vec<(&'static str, Light, f64)> {
+    let pi = std::f64::consts::PI;
     let a = 0.25f64; // 0.5 × 0.5 square
     let sphere = Geo::Sphere {
         center: Vec3::new(0.0, 1.0, 0.0),
@@ -55,12 +63,40 @@ fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
         n: Vec3::new(0.0, 0.6, 0.8),
         radius: 0.7,
     };
+    vec![
+        (
+            "half quad",
+            areas(square(Vec3::Z, 0.5, true), 10.0, false).remove(0),
+            pi * a / 2.0 * 10.0,
+        ),
+        (
+            "half quad 2-sided",
+            areas(square(Vec3::Z, 0.5, true), 10.0, true).remove(1),
+            2.0 * pi * a / 2.0 * 10.0,
+        ),
+        ("sphere", area(sphere.clone(), 3.0, false), pi * pi * 3.0),
+        (
+            "sphere 2-sided",
+            area(sphere, 3.0, true),
+            2.0 * pi * pi * 3.0,
+        ),
+        ("triangle", area(tri, 4.0, false), pi * tri_area * 4.0),
+        (
+            "disk 2-sided",
+            area(disk, 1.5, true),
+            2.0 * pi * pi * 0.49 * 1.5,
+        ),
+    ]
+}
+
+/// Punctual, directional and infinite lights and their closed-form Φ.
+fn punctual_lights_with_phi() -> Vec<(&'static str, Light, f64)> {
+    let pi = std::f64::consts::PI;
     let r2 = 3.0f64; // bounding radius² of unit_scene()
     let mut distant = Light::Distant(DistantLight::new(Transform::IDENTITY, constant(2.0), 1.0));
     distant.preprocess(&unit_scene());
     let mut inf = Light::UniformInfinite(UniformInfiniteLight::new(constant(0.5), 1.0));
     inf.preprocess(&unit_scene());
-    let pi = std::f64::consts::PI;
     let (ce, cs) = (30f64.to_radians().cos(), 25f64.to_radians().cos());
     // Goniometric: Φ = 4π·I·mean(Y); projector of a white 6×4 slide at 60°:
     // Φ = I·4·asin(sin α·sin β), tan α = 1.5·tan 30°, tan β = tan 30°
@@ -96,28 +132,6 @@ fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
         ),
         ("distant", distant, 2.0 * pi * r2),
         ("infinite", inf, 0.5 * 4.0 * pi * pi * r2),
-        (
-            "half quad",
-            areas(square(Vec3::Z, 0.5, true), 10.0, false).remove(0),
-            pi * a / 2.0 * 10.0,
-        ),
-        (
-            "half quad 2-sided",
-            areas(square(Vec3::Z, 0.5, true), 10.0, true).remove(1),
-            2.0 * pi * a / 2.0 * 10.0,
-        ),
-        ("sphere", area(sphere.clone(), 3.0, false), pi * pi * 3.0),
-        (
-            "sphere 2-sided",
-            area(sphere, 3.0, true),
-            2.0 * pi * pi * 3.0,
-        ),
-        ("triangle", area(tri, 4.0, false), pi * tri_area * 4.0),
-        (
-            "disk 2-sided",
-            area(disk, 1.5, true),
-            2.0 * pi * pi * 0.49 * 1.5,
-        ),
     ]
 }
 

@@ -1,0 +1,102 @@
+//! The densities BDPT's MIS weights are built from that no walk stored:
+//! those next to a connection, and the emission densities of light
+//! endpoints [Veach 1997, §10.2; pbrt-v3 `Vertex::Pdf`, `PdfLight`,
+//! `PdfLightOrigin`]. Conventions (area measure, vertices at infinity) are
+//! those of [`crate::integrator::subpath::Vertex`].
+
+use crate::bsdf::{SampleFlags, TransportMode};
+use crate::camera::Camera;
+use crate::integrator::subpath::{dir, to_area, Vertex, VertexKind};
+use crate::light::LightType;
+use crate::math::{Ray, Vec3};
+use crate::scene::Scene;
+use crate::spectrum::SampledSpectrum;
+
+/// Area density of `cur` generating `next`, having been reached from
+/// `prev` (`None` when `cur` is an endpoint). `mode` names the kind of
+/// walker that would do it: importance for light subpaths.
+pub(crate) fn pdf(
+    scene: &Scene,
+    camera: &Camera,
+    cur: &Vertex,
+    prev: Option<&Vertex>,
+    next: &Vertex,
+    mode: TransportMode,
+) -> f32 {
+    match (cur.kind, prev) {
+        (VertexKind::Camera, _) => pdf_camera(camera, cur, next),
+        (VertexKind::Light(_), _) | (VertexKind::Surface, None) => pdf_emission(scene, cur, next),
+        (VertexKind::Surface, Some(prev)) => pdf_scatter(cur, prev, next, mode),
+    }
+}
+
+/// BSDF density at surface vertex `cur` of scattering from `prev` to `next`.
+fn pdf_scatter(cur: &Vertex, prev: &Vertex, next: &Vertex, mode: TransportMode) -> f32 {
+    let Some(bsdf) = &cur.bsdf else { return 0.0 };
+    let (wo, wi) = (dir(cur, prev), dir(cur, next));
+    to_area(bsdf.pdf(wo, wi, mode, SampleFlags::ALL), cur, next).0
+}
+
+/// Density of the camera's ray from lens point `cur` through `next`.
+fn pdf_camera(camera: &Camera, cur: &Vertex, next: &Vertex) -> f32 {
+    let ray = Ray::new(cur.p(), dir(cur, next));
+    to_area(camera.pdf_we(&ray).1, cur, next).0
+}
+
+/// Density of the light at `cur` emitting towards `next` (the direction
+/// part of `sample_le`; for lights at infinity, the disk position part).
+pub(crate) fn pdf_emission(scene: &Scene, cur: &Vertex, next: &Vertex) -> f32 {
+    let Some(id) = cur.light_id() else { return 0.0 };
+    let light = scene.light(id);
+    if cur.at_infinity() {
+        let (pdf_pos, _) = light.pdf_le(&Ray::new(cur.p(), cur.w_inf));
+        let cos = if next.it.is_surface() {
+            next.it.n.dot(cur.w_inf).abs()
+        } else {
+            1.0
+        };
+        return pdf_pos.0 * cos;
+    }
+    let w = dir(cur, next);
+    let pdf_dir = if light.light_type() == LightType::Area {
+        light.pdf_le_area(&cur.it, w).1
+    } else {
+        light.pdf_le(&Ray::new(cur.p(), w)).1
+    };
+    to_area(pdf_dir, cur, next).0
+}
+
+/// Density of choosing `cur` as the origin of a light subpath: p_light
+/// times the position density (for lights at infinity, the direction
+/// density; zero for delta directions).
+pub(crate) fn pdf_light_origin(scene: &Scene, cur: &Vertex, next: &Vertex) -> f32 {
+    let Some(id) = cur.light_id() else { return 0.0 };
+    let light = scene.light(id);
+    let p_light = scene.light_sampler().pmf(id);
+    let w = dir(cur, next);
+    match light.light_type() {
+        LightType::Area => p_light * light.pdf_le_area(&cur.it, w).0 .0,
+        LightType::DeltaPosition => p_light * light.pdf_le(&Ray::new(cur.p(), w)).0 .0,
+        LightType::Infinite => p_light * light.pdf_le(&Ray::new(cur.p(), cur.w_inf)).1 .0,
+        LightType::DeltaDirection => 0.0,
+    }
+}
+
+/// Emitted radiance from light vertex `v` towards `w` (area lights on the
+/// surface, infinite lights along the escaped direction).
+pub(crate) fn emitted(
+    scene: &Scene,
+    v: &Vertex,
+    w: Vec3,
+    lambda: &crate::spectrum::SampledWavelengths,
+) -> SampledSpectrum {
+    let Some(id) = v.light_id() else {
+        return SampledSpectrum::zero();
+    };
+    let light = scene.light(id);
+    if v.at_infinity() {
+        light.le(&Ray::new(Vec3::ZERO, -v.w_inf), lambda)
+    } else {
+        light.l(v.p(), v.it.n, v.it.uv, w, lambda)
+    }
+}

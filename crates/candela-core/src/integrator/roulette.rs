@@ -1,0 +1,165 @@
+//! Russian roulette: one rule, with a named variant per estimator [Arvo &
+//! Kirk 1990, "Particle transport and image synthesis"; Veach 1997, §10.4.1].
+//!
+//! After scattering at a vertex of depth d (the number of surface vertices
+//! so far, this one included) a path ends with probability q and otherwise
+//! goes on with its throughput divided by 1 − q, so every estimate keeps its
+//! expectation. Only q differs between estimators, as what "a path worth
+//! continuing" means differs:
+//!
+//! - [`Roulette::Throughput`] (the path tracer): from d = 2 on, with
+//!   m = max_λ β·η², q = 1 − m when m < 1 [pbrt-v4 `PathIntegrator::Li`].
+//!   β starts at 1 at the camera, so m is the fraction of the pixel's
+//!   importance the path still carries. η² is the product of the squared
+//!   relative indices of the refractions so far: radiance transport scales
+//!   β by 1/η² entering glass, which says nothing about the path's worth, so
+//!   the test undoes it.
+//! - [`Roulette::Bidirectional`] (BDPT's camera and light subpaths and the
+//!   light tracer): from d = 4 on, q = max(0.05, 1 − m). Subpaths are short
+//!   and every vertex is reused by many connections, so the first three are
+//!   always kept; the 0.05 floor bounds the length of paths that keep their
+//!   power (in a white furnace m stays 1). Light subpaths are traced in
+//!   importance mode, where refraction does not scale β, so the walker
+//!   passes η² = 1 for them (see [`crate::integrator::subpath`]).
+//! - [`Roulette::Photon`] (photon shooting): at every scattering,
+//!   q = 1 − min(1, m′/m) with m, m′ = max_λ β before and after it, so a
+//!   surviving photon keeps roughly the power it had and the photons of a
+//!   map stay of nearly equal power, which keeps density estimates smooth
+//!   [Jensen 2001, §5.1.2; pbrt-v4 SPPM photon pass]. Absorption (ρ) rather
+//!   than path length is what ends photons.
+
+use crate::sampling::PathRng;
+use crate::spectrum::SampledSpectrum;
+
+/// Which Russian-roulette rule a walk plays (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Roulette {
+    /// The path tracer's: q = 1 − max β·η² from depth 2.
+    Throughput,
+    /// BDPT's and the light tracer's: q = max(0.05, 1 − max β·η²) from depth 4.
+    Bidirectional,
+    /// Photons': q = 1 − min(1, max β′ / max β) at every scattering.
+    Photon,
+}
+
+impl Roulette {
+    /// The probability of ending the path after scattering at depth `depth`,
+    /// with throughput `before` the scattering and `after` it, and `eta_scale`
+    /// the product of η² over its refractions; `None` when the rule plays no
+    /// roulette there (then no random number is drawn).
+    pub fn kill_probability(
+        self,
+        depth: u32,
+        before: &SampledSpectrum,
+        after: &SampledSpectrum,
+        eta_scale: f32,
+    ) -> Option<f32> {
+        match self {
+            Roulette::Throughput => {
+                let m = (*after * eta_scale).max_component();
+                (m < 1.0 && depth > 1).then(|| (1.0 - m).max(0.0))
+            }
+            Roulette::Bidirectional => {
+                let m = (*after * eta_scale).max_component();
+                (m < 1.0 && depth > 3).then(|| (1.0 - m).max(0.05))
+            }
+            Roulette::Photon => {
+                let ratio = after.max_component() / before.max_component();
+                if !(ratio > 0.0) {
+                    return Some(1.0); // absorbed, or a NaN from a degenerate sample
+                }
+                (ratio < 1.0).then(|| 1.0 - ratio)
+            }
+        }
+    }
+
+    /// Plays the rule after a scattering that took β from `before` to `beta`;
+    /// returns false to end the path, else divides `beta` by the survival
+    /// probability.
+    pub fn play<R: PathRng + ?Sized>(
+        self,
+        depth: u32,
+        before: &SampledSpectrum,
+        beta: &mut SampledSpectrum,
+        eta_scale: f32,
+        rng: &mut R,
+    ) -> bool {
+        let Some(q) = self.kill_probability(depth, before, beta, eta_scale) else {
+            return true;
+        };
+        if q >= 1.0 || rng.u1() < q {
+            return false;
+        }
+        *beta /= 1.0 - q;
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::StreamRng;
+
+    #[test]
+    fn each_rule_kills_with_its_stated_probability() {
+        let s = SampledSpectrum::splat;
+        let (one, half) = (s(1.0), s(0.5));
+        let t = Roulette::Throughput;
+        assert_eq!(
+            t.kill_probability(1, &one, &half, 1.0),
+            None,
+            "depth 1 is kept"
+        );
+        assert_eq!(t.kill_probability(2, &one, &half, 1.0), Some(0.5));
+        assert_eq!(
+            t.kill_probability(2, &one, &half, 2.25),
+            None,
+            "η² undoes refraction"
+        );
+        let b = Roulette::Bidirectional;
+        assert_eq!(b.kill_probability(3, &one, &half, 1.0), None);
+        assert_eq!(b.kill_probability(4, &one, &half, 1.0), Some(0.5));
+        assert_eq!(b.kill_probability(4, &one, &s(0.999), 1.0), Some(0.05));
+        let p = Roulette::Photon;
+        assert_eq!(p.kill_probability(1, &s(2.0), &s(1.5), 1.0), Some(0.25));
+        assert_eq!(
+            p.kill_probability(1, &half, &one, 1.0),
+            None,
+            "gains keep the photon"
+        );
+        assert_eq!(p.kill_probability(1, &one, &s(0.0), 1.0), Some(1.0));
+        assert_eq!(p.kill_probability(1, &one, &s(f32::NAN), 1.0), Some(1.0));
+    }
+
+    #[test]
+    fn roulette_keeps_the_expected_throughput() {
+        // E[β after roulette] = β: the mean of n plays is within 5σ of β,
+        // σ² = β²·q/(1 − q) per play (Bernoulli survival scaled by 1/(1 − q)).
+        let n = 400_000;
+        for (rule, depth, before, after) in [
+            (Roulette::Throughput, 2, 1.0f32, 0.3f32),
+            (Roulette::Bidirectional, 5, 1.0, 0.02),
+            (Roulette::Photon, 1, 0.8, 0.2),
+        ] {
+            let (b, a) = (
+                SampledSpectrum::splat(before),
+                SampledSpectrum::splat(after),
+            );
+            let q = rule.kill_probability(depth, &b, &a, 1.0).unwrap_or(0.0) as f64;
+            let mut rng = StreamRng::new(9, depth as u64, 0);
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                let mut beta = a;
+                if rule.play(depth, &b, &mut beta, 1.0, &mut rng) {
+                    sum += beta[0] as f64;
+                }
+            }
+            let mean = sum / n as f64;
+            let sigma = after as f64 * (q / (1.0 - q)).sqrt() / (n as f64).sqrt();
+            assert!(
+                (mean - after as f64).abs() <= 5.0 * sigma,
+                "{rule:?}: {mean} vs {after} ± {sigma}"
+            );
+        }
+    }
+}

@@ -1,0 +1,333 @@
+//! The one subpath walker: a random walk by BSDF sampling that every
+//! estimator traces its light and camera subpaths with [Veach 1997, §10.2;
+//! pbrt-v3 `RandomWalk` under `GenerateLightSubpath`; SmallVCM
+//! `vertexcm.hxx`, the light-path loop of `RunIteration` with
+//! `SampleScattering`].
+//!
+//! A walk starts from a ray leaving an endpoint ([`start_light_subpath`], a
+//! camera ray, or a surface point for final gathering) with throughput β.
+//! At each surface hit with a BSDF it makes a [`Vertex`] and hands it to a
+//! [`Visitor`], which decides what the vertex is for and how the walk goes
+//! on ([`Flow`]): photon shooting deposits a photon, the light tracer
+//! connects it to the camera, BDPT stores it, the photon estimators' camera
+//! walks ([`crate::integrator::camera_walk`]) shade it or stop there.
+//! Interfaces (materials without a BSDF) are crossed without a vertex.
+//! Then, unless the visitor stopped it or the vertex is at the walk's
+//! deepest allowed depth, the walk samples the BSDF in the walk's transport
+//! mode, multiplies β by f·|ωi·ns|/p (times the adjoint shading-normal
+//! correction |ωo·ns||ωi·ng|/(|ωo·ng||ωi·ns|) in importance mode [Veach 1997,
+//! eq. 5.19]) and plays its [`Roulette`] rule.
+//!
+//! **Densities.** A visitor with [`Visitor::DENSITIES`] (BDPT now, VCM next)
+//! gets each vertex's forward density converted to area at the vertex, and
+//! after each scattering a [`Scatter`] record: the solid-angle densities of
+//! the sampled direction and of the reverse one (the BSDF evaluated with the
+//! adjoint mode), the outgoing cosine, whether the lobe was a delta (then
+//! both densities are 0 and the next vertex's forward density too, as in
+//! pbrt), and the reverse density converted to area at the previous
+//! vertex. That is what pbrt's `pdfFwd`/`pdfRev` and SmallVCM's recursive
+//! dVCM, dVC, dVM [Georgiev et al. 2012, tech. rep. eqs. 31–36] are made
+//! from: at a hit, d² and |cos θ| follow from the new vertex and the last;
+//! at a scattering, the record's densities and cosine. Other visitors skip
+//! the reverse BSDF evaluation.
+//!
+//! **Wavelengths.** The walk carries the path's wavelengths. A dispersive
+//! refraction keeps only the hero wavelength; in [`Dispersion::Fold`] (photons,
+//! whose power must stay at the wavelengths of their group) that is folded
+//! into β (hero ×4, others 0, the same expectation), in [`Dispersion::Keep`]
+//! the caller's film divides by the changed wavelength densities instead.
+
+mod start;
+mod vertex;
+
+pub use start::{start_light_subpath, LightStart};
+pub use vertex::{dir, to_area, Vertex, VertexKind};
+
+use super::roulette::Roulette;
+use crate::bsdf::{SampleFlags, TransportMode};
+use crate::math::Ray;
+use crate::sampling::{PathRng, PdfArea, PdfSolidAngle};
+use crate::scene::Scene;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// How a walk goes on after a vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Flow {
+    /// Sample the BSDF and go on.
+    Continue,
+    /// Go on only along a delta lobe: stop at once if the BSDF has none,
+    /// and after sampling if the sampled lobe is not one.
+    SpecularOnly,
+    /// End the walk here.
+    Stop,
+}
+
+/// What a walk does with dispersion (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dispersion {
+    /// The wavelengths' densities change; the film divides by them.
+    Keep,
+    /// The change is folded into β so the wavelengths' densities stay.
+    Fold,
+}
+
+/// How a walk scatters and when it ends.
+#[derive(Clone, Copy, Debug)]
+pub struct Walk {
+    /// Transport mode of the BSDF samples.
+    pub mode: TransportMode,
+    /// Depth of the deepest vertex visited; the walk never scatters there.
+    pub max_depth: u32,
+    /// Russian roulette after each scattering (`None`: no roulette).
+    pub roulette: Option<Roulette>,
+    /// Roughen near-specular lobes after the first non-specular scattering.
+    pub regularize: bool,
+    /// Dispersion handling.
+    pub dispersion: Dispersion,
+}
+
+/// Where a walk starts.
+#[derive(Clone, Copy, Debug)]
+pub struct Start {
+    /// The ray leaving the start vertex.
+    pub ray: Ray,
+    /// Throughput carried along it.
+    pub beta: SampledSpectrum,
+    /// Depth of the start vertex (0 for camera and light endpoints).
+    pub depth: u32,
+    /// The start vertex, from which the first vertex's forward density is
+    /// converted (needed by [`Visitor::DENSITIES`] visitors only).
+    pub from: Option<Vertex>,
+    /// Solid-angle density of the ray's direction at the start vertex (for
+    /// a light at infinity: the density of its origin on the scene's disk).
+    pub pdf_dir: PdfSolidAngle,
+}
+
+/// One scattering, reported to [`Visitor::DENSITIES`] visitors.
+#[derive(Clone, Copy, Debug)]
+pub struct Scatter {
+    /// The sampled lobe was a delta.
+    pub delta: bool,
+    /// Density of the sampled direction (0 for a delta).
+    pub pdf_fwd: PdfSolidAngle,
+    /// Density of the reverse direction with the adjoint mode (0 for a delta).
+    pub pdf_rev: PdfSolidAngle,
+    /// |ωi·ns| of the sampled direction.
+    pub cos_out: f32,
+    /// `pdf_rev` converted to area at the previous vertex.
+    pub prev_pdf_rev: PdfArea,
+}
+
+/// A ray that left the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Escape {
+    /// The ray.
+    pub ray: Ray,
+    /// Throughput along it.
+    pub beta: SampledSpectrum,
+    /// Solid-angle density of its direction (0 after a delta lobe).
+    pub pdf_dir: PdfSolidAngle,
+    /// It left from the start or by a delta scattering.
+    pub after_delta: bool,
+}
+
+/// How a walk ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum End {
+    /// The ray left the scene carrying this throughput.
+    Escaped(SampledSpectrum),
+    /// Absorbed (the BSDF sample failed, or roulette) with this throughput.
+    Absorbed(SampledSpectrum),
+    /// The visitor stopped it, it reached the depth limit, or β became zero.
+    Ended,
+}
+
+/// Decides what each vertex of a walk is for.
+pub trait Visitor<R: PathRng + ?Sized> {
+    /// True when the walk must compute densities and report each [`Scatter`].
+    const DENSITIES: bool = false;
+
+    /// Called at every surface vertex; says how the walk goes on.
+    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut R) -> Flow;
+
+    /// Called after each scattering when [`Visitor::DENSITIES`] is true.
+    fn scattered(&mut self, _s: &Scatter) {}
+
+    /// Called when the walk's ray leaves the scene.
+    fn escaped(&mut self, _e: &Escape, _lambda: &SampledWavelengths) {}
+}
+
+/// Walk state between vertices.
+struct State {
+    ray: Ray,
+    beta: SampledSpectrum,
+    depth: u32,
+    pdf_dir: PdfSolidAngle,
+    prev: Option<Vertex>,
+    after_delta: bool,
+    scattered: bool,
+    any_non_specular: bool,
+    eta_scale: f32,
+}
+
+/// Walks from `start` until the visitor, the depth limit, absorption or an
+/// escape ends it (module doc).
+pub fn walk<R, V>(
+    scene: &Scene,
+    lambda: &mut SampledWavelengths,
+    rng: &mut R,
+    w: &Walk,
+    start: Start,
+    visitor: &mut V,
+) -> End
+where
+    R: PathRng + ?Sized,
+    V: Visitor<R>,
+{
+    if start.depth >= w.max_depth {
+        return End::Ended;
+    }
+    let initial = *lambda;
+    let mut st = State {
+        ray: start.ray,
+        beta: start.beta,
+        depth: start.depth,
+        pdf_dir: start.pdf_dir,
+        prev: start.from,
+        after_delta: true,
+        scattered: false,
+        any_non_specular: false,
+        eta_scale: 1.0,
+    };
+    while !st.beta.is_black() {
+        let Some(mut si) = scene.intersect(&st.ray, f32::INFINITY) else {
+            let e = Escape {
+                ray: st.ray,
+                beta: st.beta,
+                pdf_dir: st.pdf_dir,
+                after_delta: st.after_delta,
+            };
+            visitor.escaped(&e, lambda);
+            return End::Escaped(st.beta);
+        };
+        let was_terminated = lambda.secondary_terminated();
+        let Some(mut bsdf) = scene.bsdf(&mut si, lambda) else {
+            st.ray = si.spawn_ray(st.ray.d);
+            continue;
+        };
+        if w.dispersion == Dispersion::Fold && lambda.secondary_terminated() && !was_terminated {
+            st.beta *= initial.pdf().safe_div(lambda.pdf());
+        }
+        if w.regularize && st.any_non_specular {
+            bsdf.regularize();
+        }
+        st.depth += 1;
+        let mut v = Vertex::surface(&si, bsdf, w.mode, st.beta);
+        v.depth = st.depth;
+        v.after_delta = st.after_delta;
+        v.caustic = st.scattered && !st.any_non_specular;
+        if V::DENSITIES {
+            v.pdf_fwd = match &st.prev {
+                Some(p) if p.at_infinity() => {
+                    PdfArea(st.pdf_dir.0 * si.n().dot(st.ray.d.normalize()).abs())
+                }
+                Some(p) => to_area(st.pdf_dir, p, &v),
+                None => PdfArea(0.0),
+            };
+        }
+        let flow = visitor.vertex(&v, lambda, rng);
+        if flow == Flow::Stop || st.depth >= w.max_depth {
+            return End::Ended;
+        }
+        if let Some(end) = scatter(&v, w, flow, &mut st, visitor, rng) {
+            return end;
+        }
+    }
+    End::Ended
+}
+
+/// Samples the BSDF at `v` and advances `st`; `Some` when the walk ends.
+fn scatter<R, V>(
+    v: &Vertex,
+    w: &Walk,
+    flow: Flow,
+    st: &mut State,
+    visitor: &mut V,
+    rng: &mut R,
+) -> Option<End>
+where
+    R: PathRng + ?Sized,
+    V: Visitor<R>,
+{
+    let bsdf = v.bsdf.as_ref()?;
+    let only_delta = flow == Flow::SpecularOnly;
+    if only_delta && !bsdf.flags().is_specular() {
+        return Some(End::Ended);
+    }
+    let wo = v.wo;
+    let Some(bs) = bsdf.sample_f(wo, rng.u1(), rng.u2(), w.mode, SampleFlags::ALL) else {
+        return Some(End::Absorbed(st.beta));
+    };
+    if only_delta && !bs.is_specular() {
+        return Some(End::Ended);
+    }
+    let cos = bs.wi.dot(bsdf.ns()).abs();
+    let correction = match w.mode {
+        TransportMode::Radiance => 1.0,
+        TransportMode::Importance => importance_correction(v, bs.wi),
+    };
+    let before = st.beta;
+    st.beta *= bs.f * (cos * correction / bs.pdf.0);
+    if V::DENSITIES {
+        let mut pdf_fwd = if bs.pdf_is_proportional {
+            bsdf.pdf(wo, bs.wi, w.mode, SampleFlags::ALL)
+        } else {
+            bs.pdf
+        };
+        let mut pdf_rev = bsdf.pdf(bs.wi, wo, w.mode.adjoint(), SampleFlags::ALL);
+        if bs.is_specular() {
+            pdf_fwd = PdfSolidAngle(0.0);
+            pdf_rev = PdfSolidAngle(0.0);
+        }
+        let prev_pdf_rev = match &st.prev {
+            Some(p) => to_area(pdf_rev, v, p),
+            None => PdfArea(0.0),
+        };
+        visitor.scattered(&Scatter {
+            delta: bs.is_specular(),
+            pdf_fwd,
+            pdf_rev,
+            cos_out: cos,
+            prev_pdf_rev,
+        });
+        st.pdf_dir = pdf_fwd;
+        st.prev = Some(*v);
+    } else if bs.is_specular() {
+        st.pdf_dir = PdfSolidAngle(0.0);
+    }
+    st.after_delta = bs.is_specular();
+    st.scattered = true;
+    st.any_non_specular |= !bs.is_specular();
+    if bs.is_transmission() {
+        st.eta_scale *= bs.eta * bs.eta;
+    }
+    st.ray = v.it.spawn_ray(bs.wi);
+    match w.roulette {
+        Some(rule) if !rule.play(st.depth, &before, &mut st.beta, st.eta_scale, rng) => {
+            Some(End::Absorbed(before))
+        }
+        _ => None,
+    }
+}
+
+/// |ωo·ns||ωi·ng| / (|ωo·ng||ωi·ns|): the adjoint shading-normal correction
+/// of importance transport at `v` [Veach 1997, eq. 5.19].
+#[inline]
+fn importance_correction(v: &Vertex, wi: crate::math::Vec3) -> f32 {
+    let (ns, ng) = (v.ns, v.it.n);
+    let den = v.wo.dot(ng).abs() * wi.dot(ns).abs();
+    if den == 0.0 {
+        return 0.0;
+    }
+    v.wo.dot(ns).abs() * wi.dot(ng).abs() / den
+}
