@@ -25,11 +25,15 @@
 //! passes, [`crate::film::FilmState::relative_error`]), is below the target;
 //! SPPM's passes are not independent, so it has no such estimate.
 
+mod exr;
 mod fingerprint;
+mod settings;
 mod state;
 pub mod surface;
 
+pub use exr::{encode_exr, exr_attributes, exr_layers};
 pub use fingerprint::fingerprint;
+pub use settings::{overrides_from_settings, settings_text};
 pub use state::{RenderState, StateError};
 
 use crate::build::RenderSetup;
