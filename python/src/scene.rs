@@ -58,6 +58,7 @@ pub fn overrides(
         seed,
         cropwindow,
         outfile: None,
+        ..Overrides::default()
     })
 }
 

@@ -179,44 +179,12 @@ fn parse_cropwindow(s: &str) -> Result<[f32; 4], String> {
 
 /// The settings of `ov` that decide a render's passes, as `key=value` lines.
 fn settings_text(ov: &Overrides) -> String {
-    let mut s = String::new();
-    if let Some(v) = ov.spp {
-        s.push_str(&format!("spp={v}\n"));
-    }
-    if let Some(v) = &ov.integrator {
-        s.push_str(&format!("integrator={v}\n"));
-    }
-    if let Some(v) = ov.seed {
-        s.push_str(&format!("seed={v}\n"));
-    }
-    if let Some([a, b, c, d]) = ov.cropwindow {
-        s.push_str(&format!("cropwindow={a:?},{b:?},{c:?},{d:?}\n"));
-    }
-    if !ov.aovs.is_empty() {
-        s.push_str(&format!("aov={}\n", Aov::list_text(&ov.aovs)));
-    }
-    s
+    render::settings_text(ov)
 }
 
 /// The overrides stored by [`settings_text`].
 fn overrides_from(text: &str) -> Result<Overrides> {
-    let mut ov = Overrides::default();
-    for line in text.lines() {
-        let (k, v) = line
-            .split_once('=')
-            .context("malformed settings in the state file")?;
-        match k {
-            "spp" => ov.spp = Some(v.parse().context("spp in the state file")?),
-            "integrator" => ov.integrator = Some(v.to_string()),
-            "seed" => ov.seed = Some(v.parse().context("seed in the state file")?),
-            "cropwindow" => {
-                ov.cropwindow = Some(parse_cropwindow(v).map_err(anyhow::Error::msg)?);
-            }
-            "aov" => ov.aovs = Aov::parse_list(v).map_err(anyhow::Error::msg)?,
-            _ => bail!("unknown setting {k:?} in the state file"),
-        }
-    }
-    Ok(ov)
+    render::overrides_from_settings(text).map_err(|e| anyhow::anyhow!("{e} in the state file"))
 }
 
 /// Raises the returned flag on SIGINT, SIGTERM and SIGHUP; a second signal

@@ -1,11 +1,12 @@
 //! The settings text stored in a [`super::RenderState`]: the overrides that
 //! decide a render's passes (`--spp`, `--integrator`, `--seed`,
-//! `--cropwindow`) as `key=value` lines, so that whoever merges or resumes
+//! `--cropwindow`, `--aov`) as `key=value` lines, so that whoever merges or resumes
 //! the state rebuilds the same render. The format is the command line's
 //! (`candela render` writes it, `candela merge` reads it): a state made by
 //! the library, the Python module or a cluster merges with the CLI's.
 
 use crate::build::Overrides;
+use crate::film::Aov;
 
 /// The settings of `ov` that decide a render's passes, as `key=value` lines
 /// (the output path is not one of them).
@@ -23,6 +24,9 @@ pub fn settings_text(ov: &Overrides) -> String {
     if let Some([a, b, c, d]) = ov.cropwindow {
         s.push_str(&format!("cropwindow={a:?},{b:?},{c:?},{d:?}\n"));
     }
+    if !ov.aovs.is_empty() {
+        s.push_str(&format!("aov={}\n", Aov::list_text(&ov.aovs)));
+    }
     s
 }
 
@@ -39,6 +43,7 @@ pub fn overrides_from_settings(text: &str) -> Result<Overrides, String> {
             "integrator" => ov.integrator = Some(v.to_string()),
             "seed" => ov.seed = Some(v.parse().map_err(|e| bad(&e))?),
             "cropwindow" => ov.cropwindow = Some(parse_cropwindow(v).map_err(|e| bad(&e))?),
+            "aov" => ov.aovs = Aov::parse_list(v).map_err(|e| bad(&e))?,
             _ => return Err(format!("unknown setting {k:?}")),
         }
     }
@@ -70,15 +75,21 @@ mod tests {
             seed: Some(7),
             cropwindow: Some([0.25, 0.5, 0.0, 1.0]),
             outfile: Some("ignored.exr".into()),
+            aovs: vec![Aov::Surface(crate::film::SurfaceAov::Albedo), Aov::Variance],
+            memory_limit: Some(1 << 30),
         };
         let text = settings_text(&ov);
         assert_eq!(
             text,
-            "spp=12\nintegrator=ppm\nseed=7\ncropwindow=0.25,0.5,0.0,1.0\n"
+            "spp=12\nintegrator=ppm\nseed=7\ncropwindow=0.25,0.5,0.0,1.0\naov=albedo,variance\n"
         );
         let back = overrides_from_settings(&text).expect("round trip");
         assert_eq!(settings_text(&back), text);
         assert_eq!(back.outfile, None);
+        assert_eq!(
+            back.memory_limit, None,
+            "the memory limit is not a render's identity"
+        );
         assert_eq!(settings_text(&Overrides::default()), "");
         for bad in ["spp", "spp=x\n", "colour=red\n", "cropwindow=0.5,0.2,0,1\n"] {
             assert!(overrides_from_settings(bad).is_err(), "{bad:?}");

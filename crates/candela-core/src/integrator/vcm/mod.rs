@@ -240,7 +240,11 @@ impl Integrator for VcmIntegrator {
         let radius = self.radius(pass);
         let n_light = self.light_paths(ctx) as f32;
         let f = Factors::new(radius, n_light, t.connect, t.merge);
-        let lambda = pass_wavelengths(self.settings.seed, pass);
+        // One wavelength group: every light and camera path of the iteration
+        // shares its wavelengths, so merged power stays spectral.
+        let lambda = pass_wavelengths(self.settings.seed, pass, 1)
+            .group(0)
+            .clone();
         let time = self.time(ctx, pass);
         let Some(light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
             return PassOutcome::Cancelled;
