@@ -150,8 +150,8 @@ LightSource "infinite"
         &candela_core::render::NoProgress,
         &mut |_| {},
     )
-    .err()
-    .expect("refused")
+    .map(|_| ())
+    .expect_err("refused")
     .to_string();
     assert!(e.contains("spectral") && e.contains("sppm"), "{e}");
 }

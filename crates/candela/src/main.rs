@@ -26,7 +26,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Render a pbrt-v4 scene to EXR (linear, float) and PNG (tone-mapped sRGB).
-    Render(render_cmd::RenderArgs),
+    Render(Box<render_cmd::RenderArgs>),
     /// Parse and build a scene without rendering: print what it contains
     /// (shapes, triangles, lights, materials, textures, camera, film, sampler,
     /// integrator) and every warning.
@@ -68,7 +68,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.cmd {
         Cmd::Render(args) if args.check_only => info(&args.scene, &args.overrides()),
-        Cmd::Render(args) => render_cmd::render(args),
+        Cmd::Render(args) => render_cmd::render(*args),
         Cmd::Info { scene } => info(&scene, &Overrides::default()),
         Cmd::Diff { a, b, region } => diff(&a, &b, region).map(|()| 0),
         Cmd::Merge(args) => render_cmd::merge(args).map(|()| 0),

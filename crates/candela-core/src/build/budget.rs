@@ -66,7 +66,7 @@ pub fn parse_memory(s: &str) -> Result<u64, String> {
         _ => return Err(bad()),
     };
     let bytes = x * scale;
-    if !(bytes >= 1.0 && bytes < 1e18) {
+    if !(1.0..1e18).contains(&bytes) {
         return Err(bad());
     }
     Ok(bytes as u64)

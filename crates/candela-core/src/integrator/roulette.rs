@@ -65,10 +65,11 @@ impl Roulette {
             }
             Roulette::Photon => {
                 let ratio = after.max_component() / before.max_component();
-                if !(ratio > 0.0) {
-                    return Some(1.0); // absorbed, or a NaN from a degenerate sample
+                // Absorbed, or a NaN from a degenerate sample: killed.
+                if ratio.is_nan() || ratio <= 0.0 {
+                    return Some(1.0);
                 }
-                (ratio < 1.0).then(|| 1.0 - ratio)
+                (ratio < 1.0).then_some(1.0 - ratio)
             }
         }
     }

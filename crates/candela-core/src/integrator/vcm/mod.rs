@@ -242,9 +242,7 @@ impl Integrator for VcmIntegrator {
         let f = Factors::new(radius, n_light, t.connect, t.merge);
         // One wavelength group: every light and camera path of the iteration
         // shares its wavelengths, so merged power stays spectral.
-        let lambda = pass_wavelengths(self.settings.seed, pass, 1)
-            .group(0)
-            .clone();
+        let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);
         let time = self.time(ctx, pass);
         let Some(light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
             return PassOutcome::Cancelled;
