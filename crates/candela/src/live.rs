@@ -10,7 +10,6 @@
 //! than about a tenth of the render's time spent on frames. The final
 //! image is always sent.
 
-use crate::output;
 use anyhow::{Context, Result};
 use candela_core::build::RenderSetup;
 use candela_core::display::{Frame, LiveView, LiveViewOptions};
@@ -83,7 +82,11 @@ impl Live {
     fn send(&mut self, setup: &RenderSetup, state: &RenderState) {
         let t = Instant::now();
         let dev = render::develop_state(setup, state);
-        match Frame::from_exr_layers(dev.width, dev.height, &output::layers(&dev)) {
+        match Frame::from_exr_layers(
+            dev.width,
+            dev.height,
+            &candela_core::render::exr_layers(&dev),
+        ) {
             Ok(f) => self.view.send(f),
             Err(e) => eprintln!("candela: warning: live view: {e}"),
         }

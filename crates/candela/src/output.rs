@@ -4,7 +4,8 @@
 
 use anyhow::{bail, Context, Result};
 use candela_core::film::Developed;
-use candela_core::image::{write_exr_layers, ExrAttribute, ExrAttributes, ExrChannel, ExrLayer};
+use candela_core::image::{write_exr_layers, ExrAttributes};
+use candela_core::render;
 use std::path::{Path, PathBuf};
 
 /// The EXR path for `outfile` (`.exr`, or `.png` meaning an EXR beside it);
@@ -36,35 +37,6 @@ pub fn check_writable(exr: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The developed channels as EXR layers: a channel name `layer.C` goes to
-/// layer `layer` as channel `C` (the part after the last '.'), others to the
-/// root layer, so readers see pbrt-v4's and candela's channel names.
-pub fn layers(dev: &Developed) -> Vec<ExrLayer> {
-    let mut out: Vec<ExrLayer> = Vec::new();
-    for ch in &dev.channels {
-        let (layer, name) = ch.name.rsplit_once('.').unwrap_or(("", ch.name.as_str()));
-        let c = ExrChannel::new(name, ch.data.clone());
-        match out.iter_mut().find(|l| l.name == layer) {
-            Some(l) => l.channels.push(c),
-            None => out.push(ExrLayer::new(layer, vec![c])),
-        }
-    }
-    out
-}
-
-/// Header attributes: how many passes the image holds, of how many planned.
-pub fn attributes(dev: &Developed, integrator: &str, total_passes: u64) -> ExrAttributes {
-    let mut a = ExrAttributes::new();
-    let int = |v: u64| ExrAttribute::Int(i32::try_from(v).unwrap_or(i32::MAX));
-    a.insert("candela.passes".into(), int(dev.passes));
-    a.insert("candela.plannedPasses".into(), int(total_passes));
-    a.insert(
-        "candela.integrator".into(),
-        ExrAttribute::Text(integrator.to_string()),
-    );
-    a
-}
-
 /// Writes the developed image as `exr` (every layer) and a PNG beside it,
 /// and the strategy images (`names[k]`) in the same directory.
 pub fn write(
@@ -73,7 +45,7 @@ pub fn write(
     attrs: &ExrAttributes,
     strategy_names: &[Option<String>],
 ) -> Result<()> {
-    write_exr_layers(exr, dev.width, dev.height, &layers(dev), attrs)?;
+    write_exr_layers(exr, dev.width, dev.height, &render::exr_layers(dev), attrs)?;
     dev.rgb().write_png(&exr.with_extension("png"), 0.0)?;
     let dir = exr.parent().unwrap_or(Path::new(""));
     for (img, name) in dev.strategies.iter().zip(strategy_names) {

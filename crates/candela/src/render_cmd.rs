@@ -107,7 +107,7 @@ pub struct RenderArgs {
     /// Render only the part x0 ≤ x < x1, y0 ≤ y < y1 of the image, in [0, 1]
     /// fractions of the film ("x0,x1,y0,y1", pbrt-v4's `--cropwindow`);
     /// overrides the Film's "cropwindow" and "pixelbounds".
-    #[arg(long, value_parser = parse_cropwindow)]
+    #[arg(long, value_parser = render::parse_cropwindow)]
     pub cropwindow: Option<[f32; 4]>,
     /// Stop once the relative standard error of the image mean (every
     /// channel, from the spread of the per-pass means) is below this.
@@ -164,19 +164,6 @@ impl RenderArgs {
     }
 }
 
-/// Parses "x0,x1,y0,y1" with 0 ≤ x0 < x1 ≤ 1 and 0 ≤ y0 < y1 ≤ 1.
-fn parse_cropwindow(s: &str) -> Result<[f32; 4], String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|t| t.trim().parse::<f32>().map_err(|e| format!("{t:?}: {e}")))
-        .collect::<Result<_, _>>()?;
-    let unit = |a: f32, b: f32| (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b) && a < b;
-    match v[..] {
-        [x0, x1, y0, y1] if unit(x0, x1) && unit(y0, y1) => Ok([x0, x1, y0, y1]),
-        _ => Err("expected x0,x1,y0,y1 in [0, 1] with x0 < x1 and y0 < y1".into()),
-    }
-}
-
 /// The settings of `ov` that decide a render's passes, as `key=value` lines.
 fn settings_text(ov: &Overrides) -> String {
     render::settings_text(ov)
@@ -215,7 +202,7 @@ fn write_image(setup: &RenderSetup, state: &RenderState, exr: &Path) -> Result<(
         .integrator
         .develop_overlay(&state.integrator_state, state.film.passes().count());
     let dev = develop(&setup.film, &state.film, overlay.as_deref());
-    let attrs = output::attributes(&dev, &state.integrator, state.total_passes);
+    let attrs = render::exr_attributes(&dev, &state.integrator, state.total_passes);
     output::write(&dev, exr, &attrs, &strategy_names(setup))
 }
 

@@ -33,7 +33,7 @@ pub mod surface;
 
 pub use exr::{encode_exr, exr_attributes, exr_layers};
 pub use fingerprint::fingerprint;
-pub use settings::{overrides_from_settings, settings_text};
+pub use settings::{overrides_from_settings, parse_cropwindow, settings_text};
 pub use state::{RenderState, StateError};
 
 use crate::build::RenderSetup;

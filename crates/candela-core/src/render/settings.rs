@@ -51,7 +51,7 @@ pub fn overrides_from_settings(text: &str) -> Result<Overrides, String> {
 }
 
 /// Parses "x0,x1,y0,y1" with 0 ≤ x0 < x1 ≤ 1 and 0 ≤ y0 < y1 ≤ 1.
-fn parse_cropwindow(s: &str) -> Result<[f32; 4], String> {
+pub fn parse_cropwindow(s: &str) -> Result<[f32; 4], String> {
     let v: Vec<f32> = s
         .split(',')
         .map(|t| t.trim().parse::<f32>().map_err(|e| format!("{t:?}: {e}")))
