@@ -48,6 +48,8 @@
 mod camera;
 pub mod light;
 pub mod mis;
+#[cfg(test)]
+mod mis_brute;
 
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
