@@ -208,7 +208,7 @@ fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
     // Light subpath: the state at x_1 ..= x_m.
     let mut lp = vec![Partial::default(); m + 1];
     let mut st = Partial::light(direct, emission, cos_light, p.light == Emitter::Point, f);
-    for k in 1..=m {
+    for (k, state) in lp.iter_mut().enumerate().skip(1) {
         if k >= 2 {
             st.scatter(
                 p.delta[k - 1],
@@ -224,7 +224,7 @@ fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
             seg(k - 1).0
         };
         st.hit(d2, seg(k - 1).2);
-        lp[k] = st;
+        *state = st;
     }
     // Camera subpath: the state at x_m ..= x_1, then at the light.
     let mut cp = vec![Partial::default(); m + 1];
