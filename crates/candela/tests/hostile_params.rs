@@ -362,6 +362,27 @@ fn command_line_values_name_the_flag_not_the_scene() {
         "{err}"
     );
     assert!(!err.contains("s.pbrt"), "blames the scene: {err}");
+    // The file's parameters read by the flag's integrator say so.
+    let opt = "Integrator \"path\" \"integer photonsperiteration\" [1000000000]";
+    std::fs::write(
+        d.join("p.pbrt"),
+        scene(FILM, SAMPLER, opt, "Shape \"sphere\""),
+    )
+    .unwrap();
+    let args = [
+        "render",
+        "p.pbrt",
+        "--integrator",
+        "sppm",
+        "--memory-limit",
+        "1G",
+    ];
+    let err = refused(&candela(&args, &d), 1, "override");
+    let what = "Integrator \"path\" (rendered as \"sppm\" by --integrator) \"photonsperiteration\"";
+    assert!(
+        err.contains(&format!("p.pbrt:5:19: {what} needs about")),
+        "{err}"
+    );
     let err = refused(&render(&["--nthreads", "0"]), 1, "nthreads");
     assert!(err.contains("--nthreads must be at least 1"), "{err}");
     // clap's usage errors exit 2 and quote the flag.
