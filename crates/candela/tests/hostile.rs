@@ -74,6 +74,42 @@ fn plymesh_with_a_two_index_face_is_a_located_error() {
     );
 }
 
+/// Issue 11: "a PLY whose header declares fewer vertices than it holds
+/// ... yields 0 triangles silently". ASCII and binary, the left-over data is
+/// a located error (a line, or a byte offset).
+#[test]
+fn plymesh_holding_more_than_its_header_declares_is_a_located_error() {
+    let d = tmpdir("plycount");
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        )
+    };
+    let ascii = format!("{}0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n", header("ascii"));
+    let mut binary = header("binary_little_endian").into_bytes();
+    for x in [0f32, 0., 0., 1., 0., 0., 0., 1., 0., 1., 1., 0.] {
+        binary.extend(x.to_le_bytes());
+    }
+    binary.push(3);
+    for i in [0i32, 1, 2] {
+        binary.extend(i.to_le_bytes());
+    }
+    std::fs::write(
+        d.join("s.pbrt"),
+        format!("{HEAD}Shape \"plymesh\" \"string filename\" \"m.ply\"\n"),
+    )
+    .unwrap();
+    for (bytes, at) in [(ascii.into_bytes(), "m.ply:13:"), (binary, "m.ply: ")] {
+        std::fs::write(d.join("m.ply"), bytes).unwrap();
+        let err = clean_error(&candela(&["render", "s.pbrt", "--quiet"], &d));
+        assert!(
+            err.contains(&format!("s.pbrt:6:1: bad PLY file: {at}")),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn a_byte_order_mark_is_accepted() {
     let d = tmpdir("bom");

@@ -234,3 +234,35 @@ fn progress_is_plain_lines_when_stderr_is_not_a_terminal() {
     let quiet = candela(&["render", "s.pbrt", "--quiet", "--outfile", "o.exr"], &d);
     assert!(!String::from_utf8_lossy(&quiet.stderr).contains("%, ETA"));
 }
+
+/// Issue 11: "SIGINT/SIGTERM/SIGHUP kill the render with nothing written".
+/// SIGINT is tested with resuming in `passes.rs`; here the other two stop a
+/// long render, which writes its image (of the passes done) and exits 130.
+#[test]
+fn sigterm_and_sighup_stop_the_render_and_write_its_image() {
+    let d = tmpdir("signals");
+    std::fs::write(d.join("s.pbrt"), scene(64, 32, 100_000, "")).unwrap();
+    for sig in ["TERM", "HUP"] {
+        let out = format!("{sig}.exr");
+        let child = command(&["render", "s.pbrt", "--quiet", "--outfile", &out], &d)
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(1500));
+        let kill = Command::new("kill")
+            .args([&format!("-{sig}"), &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(kill.success());
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(130), "SIG{sig}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        let img = RgbImage::read_exr(&d.join(&out)).unwrap();
+        assert_eq!((img.width, img.height), (64, 32));
+        assert!(
+            img.pixels.iter().any(|p| p[0] > 0.0),
+            "SIG{sig}: black image"
+        );
+    }
+}
