@@ -324,6 +324,25 @@ fn memory_hungry_settings_are_refused_before_allocating_even_by_info() {
     );
     // Each error names the parameter to change, after the limit.
     let d = tmpdir("memory-fix");
+    // The long fuzz run's cap hits: a 2³¹-wide film whose 2 % crop still
+    // has 43 M pixels, run (as the fuzzer now runs it) under a 1 GB budget.
+    let wide = "\"integer xresolution\" [2147483647] \"integer yresolution\" [64]";
+    std::fs::write(
+        d.join("w.pbrt"),
+        scene(wide, SAMPLER, "", "Shape \"sphere\""),
+    )
+    .unwrap();
+    let args = ["render", "w.pbrt", "--cropwindow", "0.26,0.28,0.88,0.9"];
+    let o = candela(
+        &[&args[..], &["--memory-limit", "1G", "--quiet"]].concat(),
+        &d,
+    );
+    let err = refused(&o, 1, "wide film");
+    assert!(
+        err.starts_with("candela: error: w.pbrt:3:1: Film \"rgb\" needs about"),
+        "{err}"
+    );
+    assert!(err.contains("over the --memory-limit of 1.0 GB"), "{err}");
     for (opt, fix) in [
         (
             "PixelFilter \"gaussian\" \"float xradius\" [1e6]",
