@@ -201,3 +201,44 @@ fn os_errors_are_printed_once() {
         assert_eq!(err.matches("nope.").count(), 1, "{err}");
     }
 }
+
+/// Every saved fuzz finding (`crates/candela-fuzz/findings/*.pbrt`) stays
+/// fixed: it renders or gives one located error, within a time limit, and
+/// never panics, aborts or hangs.
+#[test]
+fn every_saved_fuzz_finding_renders_or_fails_cleanly() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../candela-fuzz/findings");
+    let out = tmpdir("findings").join("o.exr");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !name.ends_with(".pbrt") {
+            continue;
+        }
+        n += 1;
+        let mut child = Command::new(env!("CARGO_BIN_EXE_candela"))
+            .args(["render", &name, "--spp", "1", "--quiet", "--outfile"])
+            .arg(&out)
+            .current_dir(&dir)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let t = Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if t.elapsed() > Duration::from_secs(60) {
+                let _ = child.kill();
+                panic!("{name}: still running after 60 s");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().unwrap();
+        if !o.status.success() {
+            let err = clean_error(&o);
+            assert!(
+                err.starts_with(&format!("candela: error: {name}:")),
+                "{err}"
+            );
+        }
+    }
+    assert!(n >= 6, "only {n} findings");
+}
