@@ -166,7 +166,7 @@ fn worker(
         let dir = work.join(dir_name(seed));
         prepare_dir(&dir, seed)?;
         write_case(&dir, &case)?;
-        let args = candela_args("case.pbrt", crop);
+        let args = candela_args("case.pbrt", crop, cfg.runner.mem_mib / 2);
         let res = cfg.runner.run(&dir, &args)?;
         record(cfg, summary, i, seed, &case, &res)?;
     }

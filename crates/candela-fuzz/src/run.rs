@@ -97,9 +97,14 @@ pub struct RunResult {
     pub command: Vec<String>,
 }
 
-/// The arguments `candela` is run with for `scene` in `dir`.
-pub fn candela_args(scene: &str, crop: [f32; 4]) -> Vec<String> {
+/// The arguments `candela` is run with for `scene` in `dir`, with its own
+/// memory budget at `budget_mib` (half the address-space cap: the cap must
+/// also hold the binary, the scene and allocator slack). A case whose
+/// estimate is over the budget is then a clean error, and an allocation
+/// failing under the cap means candela's estimate missed a structure.
+pub fn candela_args(scene: &str, crop: [f32; 4], budget_mib: u64) -> Vec<String> {
     let cw = format!("{},{},{},{}", crop[0], crop[1], crop[2], crop[3]);
+    let budget = format!("{budget_mib}MiB");
     [
         "render",
         scene,
@@ -112,6 +117,8 @@ pub fn candela_args(scene: &str, crop: [f32; 4]) -> Vec<String> {
         &cw,
         "--outfile",
         "fuzz_out.exr",
+        "--memory-limit",
+        &budget,
     ]
     .iter()
     .map(|s| s.to_string())

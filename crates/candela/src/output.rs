@@ -29,12 +29,28 @@ pub fn check_writable(exr: &Path) -> Result<()> {
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
+    if dir.exists() && !dir.is_dir() {
+        bail!(
+            "cannot write {}: {} is not a directory",
+            exr.display(),
+            dir.display()
+        );
+    }
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let probe = dir.join(format!(".candela-write-test-{}", std::process::id()));
     std::fs::write(&probe, b"")
         .with_context(|| format!("cannot write output files in {}", dir.display()))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
+}
+
+/// The EXR path for `outfile`, checked before rendering ([`exr_path`],
+/// [`check_writable`]); errors start with `origin`, where the path came
+/// from (`--outfile`, or the place of the Film's `"filename"`).
+pub fn checked_exr(outfile: &Path, origin: &str) -> Result<PathBuf> {
+    let exr = exr_path(outfile).with_context(|| origin.to_string())?;
+    check_writable(&exr).with_context(|| origin.to_string())?;
+    Ok(exr)
 }
 
 /// Writes the developed image as `exr` (every layer) and a PNG beside it,

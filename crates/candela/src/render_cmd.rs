@@ -9,6 +9,7 @@ use candela_core::film::develop::develop;
 use candela_core::film::Aov;
 use candela_core::integrator::{IntegratorKind, Visualize};
 use candela_core::render::{self, RenderOptions, RenderState, StopReason};
+use candela_scene::SceneDescription;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -206,6 +207,19 @@ fn write_image(setup: &RenderSetup, state: &RenderState, exr: &Path) -> Result<(
     output::write(&dev, exr, &attrs, &strategy_names(setup))
 }
 
+/// Where the output path came from, to start errors about it: the flag, or
+/// the Film's `"filename"` (or its pbrt-v4 default).
+fn outfile_origin(args: &RenderArgs, desc: &SceneDescription) -> String {
+    if args.outfile.is_some() {
+        return "--outfile".into();
+    }
+    let film = desc.film.as_ref();
+    match film.and_then(|f| f.params.param_loc("filename")) {
+        Some(loc) => format!("{loc}: Film \"filename\""),
+        None => "the default output file (no --outfile, no Film \"filename\")".into(),
+    }
+}
+
 /// `candela render`; returns the exit code.
 pub fn render(args: RenderArgs) -> Result<i32> {
     if let Some(n) = args.nthreads {
@@ -225,8 +239,7 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     for w in &setup.warnings {
         eprintln!("candela: warning: {w}");
     }
-    let exr = output::exr_path(&setup.outfile)?;
-    output::check_writable(&exr)?;
+    let exr = output::checked_exr(&setup.outfile, &outfile_origin(&args, &desc))?;
     let (mut state, opts, partial) = plan(&args, &desc, &setup, &ov, &exr)?;
     let checkpoint = opts.checkpoint.clone().unwrap_or_default();
     let load_time = t0.elapsed();
@@ -398,8 +411,7 @@ pub struct MergeArgs {
 
 /// `candela merge`.
 pub fn merge(args: MergeArgs) -> Result<()> {
-    let exr = output::exr_path(&args.outfile)?;
-    output::check_writable(&exr)?;
+    let exr = output::checked_exr(&args.outfile, "--outfile")?;
     let mut states = args
         .parts
         .iter()

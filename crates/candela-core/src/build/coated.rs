@@ -36,7 +36,7 @@ fn roughness(src: &Source, tex: &mut Textures, prefix: &str) -> Result<Roughness
 
 /// Checks of a material's parameters.
 fn check<'a>(src: &'a Source) -> Check<'a> {
-    Check::new(src.params, src.loc, "Material")
+    Check::new(src.params, src.loc, src.what)
 }
 
 /// A non-negative integer parameter that must be at least `min`.

@@ -188,8 +188,11 @@ fn pixel_bounds(
             || pb[3] as u32 > res.y
         {
             return Err(BuildError::at(
-                loc,
-                "\"pixelbounds\" must be 4 integers x0 x1 y0 y1 inside the image",
+                p.param_loc("pixelbounds").unwrap_or(loc),
+                format!(
+                    "Film \"pixelbounds\" must be 4 integers x0 x1 y0 y1 inside the {}×{} image with x0 < x1, y0 < y1, found {pb:?}",
+                    res.x, res.y
+                ),
             ));
         }
         return Ok((
@@ -201,8 +204,8 @@ fn pixel_bounds(
         let unit = |x: &f32| (0.0..=1.0).contains(x);
         if cw.len() != 4 || !cw.iter().all(unit) || cw[0] >= cw[1] || cw[2] >= cw[3] {
             return Err(BuildError::at(
-                loc,
-                "\"cropwindow\" must be 4 floats x0 x1 y0 y1 in [0, 1] with x0 < x1, y0 < y1",
+                p.param_loc("cropwindow").unwrap_or(loc),
+                format!("Film \"cropwindow\" must be 4 floats x0 x1 y0 y1 in [0, 1] with x0 < x1, y0 < y1, found {cw:?}"),
             ));
         }
         return Ok(crop_bounds([cw[0], cw[1], cw[2], cw[3]], res));

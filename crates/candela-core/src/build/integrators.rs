@@ -38,6 +38,8 @@ pub struct Planned<'a> {
     settings: Settings,
     /// The directive (or pbrt-v4's default).
     entity: &'a Entity,
+    /// `Integrator "NAME"` for errors, with the `--integrator` override.
+    what: String,
     /// `"float radius"` as written (SPPM and PPM).
     radius: Option<f32>,
     /// Lights are chosen in proportion to power (else uniformly).
@@ -105,7 +107,14 @@ pub fn integrator<'a>(
         ));
     }
     let p = &e.params;
-    let what = format!("Integrator \"{}\"", e.name);
+    let what = if name == e.name {
+        format!("Integrator \"{name}\"")
+    } else {
+        format!(
+            "Integrator \"{}\" (rendered as \"{name}\" by --integrator)",
+            e.name
+        )
+    };
     let ck = Check::new(p, &e.loc, &what);
     let power_sampling = light_sampler(p, &e.loc)?;
     let seed = render_seed(desc, ov)?;
@@ -135,6 +144,7 @@ pub fn integrator<'a>(
         kind,
         settings,
         entity: e,
+        what,
         radius,
         power_sampling,
         strategy_layers,
@@ -158,8 +168,7 @@ pub fn finish(
     warnings: &mut Vec<String>,
 ) -> Result<Box<dyn Integrator>, BuildError> {
     let e = plan.entity;
-    let what = format!("Integrator \"{}\"", e.name);
-    let ck = Check::new(&e.params, &e.loc, &what);
+    let ck = Check::new(&e.params, &e.loc, &plan.what);
     let radius = |warnings: &mut Vec<String>| match plan.radius {
         Some(r) => {
             warnings.extend(photon_scale::radius_warning(

@@ -100,7 +100,11 @@ fn material(
     tex: &mut Textures,
     names: &HashMap<String, MaterialId>,
 ) -> Result<Material, BuildError> {
-    let src = Source::new(&m.params, &m.loc, &m.color_space)?;
+    let what = format!("Material \"{}\"", m.ty);
+    let src = Source {
+        what: &what,
+        ..Source::new(&m.params, &m.loc, &m.color_space)?
+    };
     let bump = match m.ty.as_str() {
         "mix" | "interface" | "" | "none" => None,
         _ => bump(&src, tex)?,
@@ -127,7 +131,7 @@ fn material(
         "diffusetransmission" => Material::DiffuseTransmission {
             reflectance: tex.spectrum(&src, "reflectance", SpectrumKind::Albedo, 0.25)?,
             transmittance: tex.spectrum(&src, "transmittance", SpectrumKind::Albedo, 0.25)?,
-            scale: super::check::Check::new(src.params, src.loc, "Material").float(
+            scale: super::check::Check::new(src.params, src.loc, src.what).float(
                 "scale",
                 1.0,
                 Domain::NonNegative,

@@ -38,6 +38,8 @@ pub struct Source<'b> {
     pub cs: &'static ColorSpace,
     /// Textures with an index below this may be named.
     pub visible: usize,
+    /// The entity, for domain errors: `Material "conductor"`.
+    pub what: &'b str,
 }
 
 impl<'b> Source<'b> {
@@ -50,6 +52,7 @@ impl<'b> Source<'b> {
             loc,
             cs,
             visible: usize::MAX,
+            what: "Material",
         })
     }
 
@@ -212,6 +215,7 @@ impl<'a> Textures<'a> {
         let d = &descs[i];
         Ok(Source {
             visible: i,
+            what: "Texture",
             ..Source::new(&d.params, &d.loc, &d.color_space)?
         })
     }
