@@ -100,7 +100,7 @@ pub fn gather(x: &Surfel, ph: &Surfel, r2: f32) -> Option<Counted> {
     }
     let cu = d.dot(u);
     let dist2 = (a + b) * (a + b) + cu * cu;
-    if !(dist2 <= r2) {
+    if dist2.is_nan() || dist2 > r2 {
         return None;
     }
     Some(Counted {
