@@ -23,6 +23,7 @@
 mod bdpt;
 pub mod camera_walk;
 pub mod driver;
+pub mod gather;
 mod light_tracer;
 pub mod nee;
 mod path;

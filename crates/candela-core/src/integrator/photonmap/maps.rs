@@ -32,19 +32,15 @@
 //! c = 1 − 2/(3κ) [Jensen 2001, eqs. 7.7–7.8]; `epanechnikov` w = 1 − t²,
 //! c = 1/2 (t = d/r).
 //!
-//! **Photons from a curved neighbourhood.** The estimate treats the photons
-//! near x as if they had landed on x's tangent plane. Jensen evaluates
-//! f(x, ωo, ωp) with each photon's world direction, which on a curved
-//! surface drops the photons whose ωp falls below x's horizon although it
-//! was above their own: in T4(b) with r ≈ 0.45 R that loses 2.5 % of the
-//! indirect light. Here ωp is instead carried into x's frame by the
-//! smallest rotation taking the photon's geometric normal to x's, so the
-//! photon keeps its direction *relative to its surface*; on a sphere under
-//! a uniform field that makes the estimate exact at any radius, and on a
-//! plane it changes nothing. A photon whose normal points against x's is
-//! taken as the same surface wound the other way (its normal is flipped
-//! first), which leaves a photon on the far face of a thin wall with its
-//! direction below x's horizon, where a reflective f is zero.
+//! **Photons from a curved neighbourhood or across an edge.** Which of the
+//! k photons count, with which direction and kernel distance, is the rule
+//! shared with `sppm` and `vcm` ([`crate::integrator::gather`]): on smooth
+//! surfaces ωp is carried into x's frame by the rotation taking the
+//! photon's normal to x's (exact on a sphere under a uniform field at any
+//! radius, where Jensen's world-space ωp loses 2.5 % in T4(b) at
+//! r ≈ 0.45 R); across a crease the neighbouring face is unfolded onto x's
+//! plane, so a room's wall photons stand for exactly the part of the disk
+//! its edge cuts off.
 //!
 //! Shading normals: a photon's density is flux per geometric area, dΦ =
 //! L_i|ωp·n_g| dω dA, while the reflected radiance integrates L_i|ωp·n_s|,
@@ -53,6 +49,7 @@
 
 use super::PhotonMapSettings;
 use crate::bsdf::{Bsdf, TransportMode};
+use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
 use crate::integrator::wavelengths::PassWavelengths;
 use crate::math::Vec3;
@@ -195,37 +192,36 @@ impl PhotonMap {
             .then(|| scratch.iter().max().map(|n| n.index))
             .flatten();
         let (ns, ng) = (q.bsdf.ns(), q.n);
+        let xs = Surfel {
+            p: q.p,
+            n: ng,
+            w: q.wo,
+        };
         let mut sum = SampledSpectrum::zero();
         for n in scratch.iter().filter(|n| Some(n.index) != skip) {
             let ph = &self.tree.items()[n.index as usize];
             if ph.depth > q.max_photon_depth {
                 continue;
             }
-            let wi = carry_direction(ph.wi, ph.n, ng);
+            let ps = Surfel {
+                p: ph.p,
+                n: ph.n,
+                w: ph.wi,
+            };
+            let Some(c) = gather(&xs, &ps, r2) else {
+                continue;
+            };
+            let wi = c.wi;
             let cos_g = wi.dot(ng).abs();
             if cos_g == 0.0 {
                 continue;
             }
             let f = q.bsdf.f(q.wo, wi, TransportMode::Radiance);
-            let w = lookup.kernel.weight(n.dist2 / r2) * wi.dot(ns).abs() / cos_g;
+            let w = lookup.kernel.weight(c.dist2 / r2) * wi.dot(ns).abs() / cos_g;
             sum += f * ph.power * w;
         }
         sum / (lookup.kernel.mean() * std::f32::consts::PI * r2)
     }
-}
-
-/// `w` rotated by the smallest rotation taking `from` to `to` (both unit),
-/// after flipping `from` if it points against `to` (module doc) [Rodrigues:
-/// v' = v·c + k×v + k(k·v)/(1 + c), k = from × to, c = from·to].
-#[inline]
-fn carry_direction(w: Vec3, from: Vec3, to: Vec3) -> Vec3 {
-    let from = if from.dot(to) < 0.0 { -from } else { from };
-    let c = from.dot(to);
-    if c >= 1.0 - 1e-7 {
-        return w;
-    }
-    let k = from.cross(to);
-    w * c + k.cross(w) + k * (k.dot(w) / (1.0 + c))
 }
 
 /// Which photon hits a map keeps.
@@ -343,27 +339,6 @@ mod tests {
     use crate::math::Frame;
     use crate::math::{Vec2, Vec3};
     use crate::sampling::{sample_cosine_hemisphere, sample_uniform_sphere, Pcg32};
-
-    #[test]
-    fn carried_directions_keep_their_angle_to_the_normal() {
-        let mut rng = Pcg32::new(3, 0);
-        let mut u2 = || Vec2::new(rng.uniform_f32(), rng.uniform_f32());
-        for _ in 0..1000 {
-            let (from, to, w) = (
-                sample_uniform_sphere(u2()),
-                sample_uniform_sphere(u2()),
-                sample_uniform_sphere(u2()),
-            );
-            let v = carry_direction(w, from, to);
-            let from = if from.dot(to) < 0.0 { -from } else { from };
-            assert!((v.length() - 1.0).abs() < 1e-4);
-            assert!(
-                (v.dot(to) - w.dot(from)).abs() < 1e-4,
-                "{v} {w} {from} {to}"
-            );
-            assert!((carry_direction(from, from, to) - to).length() < 1e-4);
-        }
-    }
 
     /// Inward-facing Lambertian query at a uniform point of the unit sphere.
     fn sphere_query_radiance(

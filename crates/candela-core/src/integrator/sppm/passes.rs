@@ -12,15 +12,11 @@
 //!    job) add β·f(x, ωp → ωo) to every visible point whose sphere contains
 //!    them [Hachisuka & Jensen 2009, eq. 7, before the 1/(πr²N) factor].
 //!
-//! The photon's direction is carried into the visible point's frame by the
-//! rotation taking the photon's surface normal to the visible point's, so a
-//! photon keeps its angle to *its own* surface. On curved surfaces the raw
-//! direction would fall below the visible point's horizon for grazing
-//! photons and lose them (a 1 % darkening at r = 0.6 in the unit-sphere
-//! furnace, where the estimate must be exact at any radius). Photons on
-//! surfaces facing away from the visible point's (n_p·n_vp ≤ 0: the other
-//! wall of a corner, the back of a thin sheet) are not gathered, as Jensen
-//! recommends against leaks [Jensen 2001, §7.1].
+//! Which photons inside a sphere count, with which direction, is the rule
+//! shared with `photonmap` and `vcm` ([`crate::integrator::gather`]): the
+//! chord kernel with each photon's direction carried into the visible
+//! point's frame on smooth surfaces, the unfolded kernel across creases, so
+//! neither a curved surface nor a room's edges lose photons.
 //!
 //! Wavelengths come in stratified groups ([`crate::integrator::wavelengths`]):
 //! a pixel's camera path carries its group's wavelengths, photon `i` those
@@ -34,6 +30,7 @@ use crate::bsdf::{Bsdf, BxdfFlags, TransportMode};
 use crate::film::Film;
 use crate::integrator::camera_walk::{camera_walk, CameraWalk};
 use crate::integrator::driver::camera_sample;
+use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
 use crate::integrator::subpath::Flow;
 use crate::integrator::wavelengths::PassWavelengths;
@@ -241,7 +238,8 @@ pub fn photon_pass(
                     }
                     grids[g].for_each_containing(h.v.p(), |j| {
                         if let Some(vp) = &visits[j as usize].vp {
-                            if let Some(phi) = photon_contribution(vp, h) {
+                            let r = radius[j as usize];
+                            if let Some(phi) = photon_contribution(vp, h, r) {
                                 out.push((j, phi * scale));
                             }
                         }
@@ -264,28 +262,26 @@ pub fn photon_pass(
     Some(gathered)
 }
 
-/// β_p·f(x, ωp → ωo) of a photon hit `h` inside the sphere of `vp`, or
-/// `None` when the photon is not counted (module doc).
-fn photon_contribution(vp: &VisiblePoint, h: &PhotonHit<'_>) -> Option<SampledSpectrum> {
-    let n_p = h.v.it.n;
-    if n_p.dot(vp.n) <= 0.0 {
-        return None;
-    }
-    let wi = rotate_between(h.v.wo, n_p, vp.n);
-    let f = vp.bsdf.f(vp.wo, wi, TransportMode::Radiance);
+/// β_p·f(x, ωp → ωo) of a photon hit `h` inside the sphere (radius `r`)
+/// of `vp`, or `None` when the shared gather rule does not count it.
+fn photon_contribution(vp: &VisiblePoint, h: &PhotonHit<'_>, r: f32) -> Option<SampledSpectrum> {
+    let x = Surfel {
+        p: vp.p,
+        n: vp.n,
+        w: vp.wo,
+    };
+    let ph = Surfel {
+        p: h.v.p(),
+        n: h.v.it.n,
+        w: h.v.wo,
+    };
+    let c = gather(&x, &ph, r * r)?;
+    let f = vp.bsdf.f(vp.wo, c.wi, TransportMode::Radiance);
     let mut phi = h.v.beta * f;
     if vp.terminated {
         phi = hero_only(phi, h.terminated);
     }
     Some(phi)
-}
-
-/// Applies the rotation taking unit vector `a` to unit vector `b` (a·b > 0)
-/// to `v` [Rodrigues]: R v = (a·b) v + (a×b)×v + (a×b)((a×b)·v)/(1 + a·b).
-fn rotate_between(v: Vec3, a: Vec3, b: Vec3) -> Vec3 {
-    let c = a.dot(b);
-    let k = a.cross(b);
-    c * v + k.cross(v) + k * (k.dot(v) / (1.0 + c))
 }
 
 /// A camera path that kept only the hero wavelength sees only the hero part
@@ -312,25 +308,4 @@ pub fn pass_wavelengths(seed: u64, pass: u64, groups: u32) -> PassWavelengths {
         (crate::sampling::hash_u64s(&[seed, 0x5350_504d]) >> 11) as f64 / (1u64 << 53) as f64;
     let u = (offset + pass as f64 * 0.618_033_988_749_895).fract();
     PassWavelengths::new(seed, pass, u, groups)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::rotate_between;
-    use crate::math::Vec3;
-
-    #[test]
-    fn rotation_between_normals_maps_a_to_b_and_keeps_angles() {
-        let a = Vec3::new(0.2, 0.3, 0.9).normalize();
-        let b = Vec3::new(-0.4, 0.1, 0.8).normalize();
-        assert!((rotate_between(a, a, b) - b).length() < 1e-6);
-        let v = Vec3::new(0.6, -0.7, 0.2).normalize();
-        let w = rotate_between(v, a, b);
-        assert!((w.length() - 1.0).abs() < 1e-6);
-        assert!(
-            (w.dot(b) - v.dot(a)).abs() < 1e-6,
-            "angle to the normal is kept"
-        );
-        assert!((rotate_between(v, a, a) - v).length() < 1e-6);
-    }
 }

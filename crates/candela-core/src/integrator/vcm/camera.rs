@@ -9,10 +9,11 @@
 //! - a connection to each vertex of the light subpath with the pixel's index
 //!   (eqs. 40–41);
 //! - a merge with every light vertex of the iteration within the radius
-//!   (eqs. 38–39), L += β_E Σ f·β_L / (π r² N_light), the light vertex's
-//!   `wo` as the incident direction. As in SPPM, light vertices on surfaces
-//!   facing away (n_L·n_E ≤ 0) are not merged, against leaks through thin
-//!   walls [Jensen 2001, §7.1].
+//!   (eqs. 38–39), L += β_E Σ f·β_L / (π r² N_light); which light vertices
+//!   count, with which incident direction, is the rule shared with SPPM and
+//!   the photon map ([`crate::integrator::gather`]: the chord kernel on
+//!   smooth surfaces, the unfolded one across creases, nothing from a thin
+//!   wall's far side).
 //!
 //! The pixel's β includes the camera ray's weight; everything found is added
 //! with the film's filter weight to a [`FilmTile`], so the camera side
@@ -24,6 +25,7 @@ use super::VcmIntegrator;
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::film::FilmTile;
 use crate::integrator::driver::camera_sample;
+use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::nee::{sample_light, Receiver};
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
@@ -340,13 +342,25 @@ impl CameraVisitor<'_, '_> {
         let max_depth = self.vcm.settings.max_depth;
         let verts = &self.cp.light.vertices;
         let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
+        let r2 = self.cp.radius * self.cp.radius;
+        let x = Surfel {
+            p: v.p(),
+            n: v.it.n,
+            w: v.wo,
+        };
         let mut sum = SampledSpectrum::zero();
         grid.for_each_within(v.p(), self.cp.radius, |i, _| {
             let lv = &verts[i as usize];
-            if lv.v.depth + v.depth > max_depth + 1 || lv.v.it.n.dot(v.it.n) <= 0.0 {
+            if lv.v.depth + v.depth > max_depth + 1 {
                 return;
             }
-            let wi = lv.v.wo;
+            let ph = Surfel {
+                p: lv.v.p(),
+                n: lv.v.it.n,
+                w: lv.v.wo,
+            };
+            let Some(c) = gather(&x, &ph, r2) else { return };
+            let wi = c.wi;
             let fv = cb.f(v.wo, wi, TransportMode::Radiance);
             if fv.is_black() {
                 return;
