@@ -120,11 +120,7 @@ fn ppm_passes(scene: &Scene, s: &PhotonMeasureSettings, points: &[(Vec3, Vec3)])
 }
 
 /// One illuminance estimate per point and SPPM chain [lx].
-fn sppm_chains(
-    scene: &Scene,
-    s: &PhotonMeasureSettings,
-    points: &[(Vec3, Vec3)],
-) -> Vec<Vec<f64>> {
+fn sppm_chains(scene: &Scene, s: &PhotonMeasureSettings, points: &[(Vec3, Vec3)]) -> Vec<Vec<f64>> {
     let chains = s.passes.min(SPPM_CHAINS);
     let r0 = f64::from(s.radius);
     (0..chains)
@@ -144,7 +140,10 @@ fn sppm_chains(
                 iterations += 1;
             }
             let np = iterations as f64 * s.photons as f64;
-            stats.iter().map(|st| st.tau[0] / (np * PI * st.r2)).collect()
+            stats
+                .iter()
+                .map(|st| st.tau[0] / (np * PI * st.r2))
+                .collect()
         })
         .collect()
 }
