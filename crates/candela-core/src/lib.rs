@@ -17,6 +17,7 @@ pub mod light;
 pub mod material;
 pub mod math;
 pub mod measure;
+pub mod measure_photons;
 pub mod render;
 pub mod sampler;
 pub mod sampling;

@@ -128,7 +128,7 @@ fn delta_irradiance(
 }
 
 /// K_m·(1/N) Σ_k ȳ(λ_k)·e_k/p(λ_k) [lx]; terminated wavelengths (pdf 0) count 0.
-fn luminous(e: &SampledSpectrum, lambda: &SampledWavelengths) -> f64 {
+pub(crate) fn luminous(e: &SampledSpectrum, lambda: &SampledWavelengths) -> f64 {
     let pdf = lambda.pdf();
     let n = lambda.lambdas().len();
     let y: f64 = (0..n)

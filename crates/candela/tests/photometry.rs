@@ -159,3 +159,101 @@ fn info_reads_back_a_flux_given_in_lumens() {
         .unwrap();
     assert!((lm - 500.0).abs() < 0.05, "{line}");
 }
+
+/// An IES LM-63 type C file with vertical angles 0, 90, 180 and the given
+/// horizontal angles and one candela column per horizontal plane.
+fn ies_file(h: &[f64], planes: &[[f64; 3]]) -> String {
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let values: Vec<String> = planes.iter().map(|p| join(p)).collect();
+    format!(
+        "IESNA:LM-63-2002\n[TEST] encodings\nTILT=NONE\n1 -1 1 3 {} 1 1 0 0 0\n1 1 0\n0 90 180\n{}\n{}\n",
+        h.len(),
+        join(h),
+        values.join("\n")
+    )
+}
+
+/// (flux [lm] from `candela info`, E per POINTS_IES) for an IES file.
+fn ies_light(d: &PathBuf, text: &str) -> (f64, Vec<(f64, f64)>) {
+    std::fs::write(d.join("t.ies"), text).unwrap();
+    let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+                 LightSource \"goniometric\" \"string filename\" \"t.ies\" \"point3 from\" [0 0 2] \"point3 to\" [0 0 0]\n";
+    let e = measure(d, scene, POINTS_IES);
+    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
+        .args(["info", "s.pbrt"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.contains("flux      total"))
+        .unwrap();
+    let lm = line
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .trim()
+        .trim_end_matches(" lm");
+    (lm.parse().unwrap(), e)
+}
+
+/// Floor points 2 m below the luminaire at horizontal angles 0°, 90°, 45°
+/// and 122° (folds to 58° in a quadrant-symmetric light).
+const POINTS_IES: &str = "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1.5 0 0 0 1\n1 1 0 0 0 1\n-0.5 0.8 0 0 0 1\n";
+
+#[test]
+fn ies_symmetry_encodings_give_the_same_light_and_flux() {
+    // I(V, H) = 100 + (c(H) − 100)·V/90° for V ≤ 90°, c(H)·(180° − V)/90°
+    // beyond, with c linear in the horizontal angle folded into [0°, 90°]
+    // (c = 150 at 0°, 210 at 90°): bilinear in the angles, so the web is
+    // exact and E = I·cos θ/r² at each point. Its flux
+    // Φ = ∫₀^{2π} [100(1 − 2/π) + c(H)·4/π] dH = 200π − 400 + 8·mean(c);
+    // the axial light (c = 150 everywhere) the same with mean(c) = 150.
+    let d = dir("encodings");
+    let axial = [150.0; 5];
+    let quad = [150.0, 210.0, 150.0, 210.0, 150.0];
+    let col = |c: f64| [100.0, c, 0.0];
+    let all: [&[f64]; 4] = [
+        &[0.0],
+        &[0.0, 90.0],
+        &[0.0, 90.0, 180.0],
+        &[0.0, 90.0, 180.0, 270.0, 360.0],
+    ];
+    let pi = std::f64::consts::PI;
+    for (c, mean_c, encodings) in [(axial, 150.0, &all[..]), (quad, 180.0, &all[1..])] {
+        let flux = 200.0 * pi - 400.0 + 8.0 * mean_c;
+        for h in encodings {
+            let planes: Vec<[f64; 3]> = c[..h.len()].iter().map(|&c| col(c)).collect();
+            let (lm, got) = ies_light(&d, &ies_file(h, &planes));
+            assert!(
+                (lm - flux).abs() < 1e-3 * flux,
+                "{h:?}: {lm} lm, expected {flux}"
+            );
+            let pts = [
+                (0.0f64, 0.0f64),
+                (1.0, 0.0),
+                (0.0, 1.5),
+                (1.0, 1.0),
+                (-0.5, 0.8),
+            ];
+            for ((x, y), g) in pts.into_iter().zip(got) {
+                let r2 = x * x + y * y + 4.0;
+                let v = (x.hypot(y) / 2.0).atan().to_degrees();
+                let hf = y.abs().atan2(x.abs()).to_degrees();
+                let ch = if mean_c > 150.0 {
+                    150.0 + 60.0 * hf / 90.0
+                } else {
+                    150.0
+                };
+                let i = 100.0 + (ch - 100.0) * v / 90.0;
+                within_5_sigma(g, i * (2.0 / r2.sqrt()) / r2);
+            }
+        }
+    }
+}
