@@ -200,8 +200,9 @@ fn brute_force(p: &Path) -> Vec<(Technique, f64)> {
     out
 }
 
-/// The recursive weight of every technique, driven as the two passes do.
-fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
+/// The light subpath's quantities at x_1 ..= x_m and the camera
+/// subpath's at x_m ..= x_0, built as light.rs and camera.rs build them.
+fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>) {
     let m = p.m();
     let (direct, emission, cos_light) = p.light_densities();
     let seg = |k: usize| p.seg[k];
@@ -245,6 +246,15 @@ fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
         }
         cp[k] = st;
     }
+    (lp, cp)
+}
+
+/// The recursive weight of every technique, driven as the two passes do.
+fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
+    let m = p.m();
+    let (direct, emission, cos_light) = p.light_densities();
+    let seg = |k: usize| p.seg[k];
+    let (lp, cp) = subpath_states(p, f);
     let mut out = Vec::new();
     if p.light != Emitter::Point {
         out.push((
