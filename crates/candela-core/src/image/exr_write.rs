@@ -18,8 +18,11 @@
 //! - block order: the `exr` crate compresses blocks on a thread pool and, with
 //!   `LineOrder::Unspecified` (its default encoding, which `write_rgb_file`
 //!   used: RLE in 64² tiles), writes them as they finish. We write scan-line
-//!   blocks in `LineOrder::Increasing`, sequentially (`non_parallel`: no
-//!   thread pool is built per file beside the renderer's);
+//!   blocks in `LineOrder::Increasing`: the crate still compresses them in
+//!   parallel but stashes finished blocks and writes them in index order
+//!   (its `SortedBlocksWriter` sorts whenever the line order is not
+//!   `Unspecified`), so the bytes are fixed and the ZIP compression, the
+//!   largest fixed cost of a render after the BVH build, uses every core;
 //! - compression: ZIP over 16 scan lines (deflate via `miniz_oxide`, a pure
 //!   function of its input). It is lossless for floats, read by every EXR
 //!   tool, and smaller than RLE on noisy renders; PIZ compresses noise better
@@ -241,7 +244,6 @@ fn encode(
     let mut bytes = Vec::new();
     image
         .write()
-        .non_parallel()
         .to_buffered(Cursor::new(&mut bytes))
         .map_err(|error| ImageError::Exr {
             path: path.display().to_string(),
