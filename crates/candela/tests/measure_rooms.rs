@@ -24,42 +24,22 @@
 //! bias), three rooms per estimator: family-wise false alarm < 10⁻⁵.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+mod common;
 
 /// A fresh temporary directory for one test.
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("candela-rooms-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::dir("rooms", name)
 }
 
-/// Runs `candela measure` with `extra` arguments; (E, stderr) per point.
+/// Runs `candela measure` (seed 3) with `extra` arguments; (E, stderr) per point.
 fn measure(d: &Path, scene: &str, points: &str, extra: &[&str]) -> Vec<(f64, f64)> {
-    std::fs::write(d.join("s.pbrt"), scene).unwrap();
-    std::fs::write(d.join("p.txt"), points).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args(["measure", "s.pbrt", "--points", "p.txt", "--seed", "3"])
-        .args(extra)
-        .current_dir(d)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(
-        lines.next(),
-        Some("x,y,z,nx,ny,nz,illuminance_lx,stderr_lx")
-    );
-    lines
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (v[6], v[7])
-        })
-        .collect()
+    let args: Vec<&str> = ["--seed", "3"]
+        .iter()
+        .copied()
+        .chain(extra.iter().copied())
+        .collect();
+    common::measure(d, scene, points, &args)
 }
 
 /// A closed 4 m cube of diffuse albedo `rho` around a 10 000 lm point light.

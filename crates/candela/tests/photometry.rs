@@ -9,48 +9,16 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+mod common;
+
 /// A fresh temporary directory for one test.
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("candela-photometry-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::dir("photometry", name)
 }
 
-/// Runs `candela measure` and returns (E, stderr) per point.
+/// Runs `candela measure` (4000 samples, seed 7) and returns (E, stderr) per point.
 fn measure(d: &PathBuf, scene: &str, points: &str) -> Vec<(f64, f64)> {
-    std::fs::write(d.join("s.pbrt"), scene).unwrap();
-    std::fs::write(d.join("p.txt"), points).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_candela"))
-        .args([
-            "measure",
-            "s.pbrt",
-            "--points",
-            "p.txt",
-            "--samples",
-            "4000",
-            "--seed",
-            "7",
-        ])
-        .current_dir(d)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(
-        lines.next(),
-        Some("x,y,z,nx,ny,nz,illuminance_lx,stderr_lx")
-    );
-    lines
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (v[6], v[7])
-        })
-        .collect()
+    common::measure(d, scene, points, &["--samples", "4000", "--seed", "7"])
 }
 
 /// Asserts `got` is within 5σ of `want` (and that σ is sane).
