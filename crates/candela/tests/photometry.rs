@@ -6,7 +6,7 @@
 //! σ its own reported standard error (i.i.d. samples, fixed seed); the few
 //! points per scene make the family-wise false-alarm rate < 10⁻⁵.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
@@ -17,7 +17,7 @@ fn dir(name: &str) -> PathBuf {
 }
 
 /// Runs `candela measure` (4000 samples, seed 7) and returns (E, stderr) per point.
-fn measure(d: &PathBuf, scene: &str, points: &str) -> Vec<(f64, f64)> {
+fn measure(d: &Path, scene: &str, points: &str) -> Vec<(f64, f64)> {
     common::measure(d, scene, points, &["--samples", "4000", "--seed", "7"])
 }
 
