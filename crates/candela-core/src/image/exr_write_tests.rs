@@ -36,7 +36,7 @@ fn samples(k: usize, n: usize) -> Vec<f32> {
         .collect()
 }
 
-/// 7x37 pixels (37 rows: two full ZIP blocks of 16 lines and a partial one),
+/// 7x37 pixels (odd sizes, 37 scan-line blocks),
 /// the layers a G-buffer film writes, and attributes of every type.
 fn sample_image() -> ExrImage {
     let (w, h) = (7, 37);
