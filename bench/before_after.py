@@ -10,7 +10,9 @@ candela` there); CANDELA_AFTER defaults to this checkout's target/release/candel
 Wall time: every case runs `--reps` times per binary, interleaved (before, after,
 after, before, ...) so that a change in machine load hits both alike; the table
 gives the median seconds of each and the ratio after/before (< 1: faster now).
-The whole process is timed (parse, build, render, write), with 2 threads.
+The whole process is timed (parse, build, render, write), with 2 threads; the
+CPU time (user + system of the process) is given beside it, a second opinion
+when other work shares the machine (it ignores waiting, not contention).
 
 `--callgrind`: each case runs under `valgrind --tool=callgrind` with one thread
 at 1 and at 3 passes per binary; the instructions of one pass, (I3 - I1)/2, and
@@ -25,6 +27,7 @@ same work whatever their defaults.
 import argparse
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -71,10 +74,14 @@ def command(binary, path, integrator, spp, threads, out):
 
 
 def wall(binary, path, integrator, spp, out):
+    """(wall seconds, CPU seconds: user + system) of one whole run."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(command(binary, path, integrator, spp, 2, out), check=True,
                    stdout=subprocess.DEVNULL)
-    return time.perf_counter() - t0
+    t = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return t, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
 def instructions(binary, path, integrator, spp, out, tmp):
@@ -120,10 +127,15 @@ def main():
                     order = [(before, tb), (after, ta)] if i % 2 == 0 else [(after, ta), (before, tb)]
                     for binary, times in order:
                         times.append(wall(binary, path, integrator, spp_wall, out))
-                b, n, spp = statistics.median(tb), statistics.median(ta), spp_wall
+                b, n, spp = (statistics.median(t[0] for t in tb),
+                             statistics.median(t[0] for t in ta), spp_wall)
+                cb, cn = statistics.median(t[1] for t in tb), statistics.median(t[1] for t in ta)
         finally:
             os.unlink(path)
-        print(f"{scene:14} {integrator:10} {spp:4} {b:13.3f} {n:13.3f} {n / b:.3f}", flush=True)
+        line = f"{scene:14} {integrator:10} {spp:4} {b:13.3f} {n:13.3f} {n / b:.3f}"
+        if not a.callgrind:
+            line += f"   cpu {cb:7.2f} -> {cn:7.2f} s ({cn / cb:.3f})"
+        print(line, flush=True)
 
 
 if __name__ == "__main__":
