@@ -43,19 +43,25 @@ pub fn display(quiet: bool) -> Display {
     }
 }
 
-/// "pass 12/64, 1.25 M samples/s, status".
+/// "pass 12/64, 1.25 M samples/s[, 0.6 M light paths/s], status".
 fn describe(s: &Snapshot) -> String {
     let passes_this_run = s.passes_done - s.passes_at_start;
     let work = passes_this_run * s.work_per_pass + s.work_in_pass;
     let secs = s.elapsed.as_secs_f64();
-    let rate = if secs > 0.0 { work as f64 / secs } else { 0.0 };
+    let per_sec = |n: f64| if secs > 0.0 { n / secs } else { 0.0 };
     let mut msg = format!(
         "pass {}/{}, {:.3} M {}/s",
         s.passes_done,
         s.passes_goal,
-        rate / 1e6,
+        per_sec(work as f64) / 1e6,
         s.unit
     );
+    if s.light_paths_per_pass > 0 && s.work_per_pass > 0 {
+        // Light paths of finished passes, and the pass under way's share of them.
+        let frac = s.work_in_pass as f64 / s.work_per_pass as f64;
+        let light = (passes_this_run as f64 + frac.min(1.0)) * s.light_paths_per_pass as f64;
+        msg.push_str(&format!(", {:.3} M light paths/s", per_sec(light) / 1e6));
+    }
     if let Some(st) = &s.status {
         msg.push_str(", ");
         msg.push_str(st);

@@ -55,6 +55,7 @@ impl Integrator for LightTracer {
         PassWork {
             units: paths_per_pass(ctx),
             unit: "light paths",
+            light_paths: 0,
         }
     }
 

@@ -132,6 +132,9 @@ pub struct PassWork {
     pub units: u64,
     /// Their name, plural ("samples", "light paths", "photons").
     pub unit: &'static str,
+    /// Light subpaths traced per pass when they are not the units (VCM,
+    /// BDPT), so that progress can show their rate; 0 otherwise.
+    pub light_paths: u64,
 }
 
 /// A pass either completes or is abandoned (its block is then discarded).

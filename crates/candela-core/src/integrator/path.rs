@@ -64,6 +64,7 @@ impl Integrator for PathIntegrator {
         PassWork {
             units: ctx.film.pixel_count() as u64,
             unit: "samples",
+            light_paths: 0,
         }
     }
     fn render_pass(

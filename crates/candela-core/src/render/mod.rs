@@ -111,6 +111,8 @@ pub struct Snapshot {
     pub work_per_pass: u64,
     /// Name of the work units.
     pub unit: &'static str,
+    /// Light subpaths per pass when they are not the units (0: none shown).
+    pub light_paths_per_pass: u64,
     /// Time since this run started.
     pub elapsed: Duration,
     /// Integrator status (radius, …).
@@ -242,6 +244,7 @@ pub fn render(
         work_in_pass: work.load(Ordering::Relaxed),
         work_per_pass: pw.units,
         unit: pw.unit,
+        light_paths_per_pass: pw.light_paths,
         elapsed: t0.elapsed(),
         status: shared.status.lock().map(|s| s.clone()).unwrap_or(None),
     };

@@ -78,6 +78,7 @@ impl Integrator for BdptIntegrator {
         PassWork {
             units: ctx.film.pixel_count() as u64,
             unit: "samples",
+            light_paths: ctx.film.pixel_count() as u64,
         }
     }
     fn render_pass(

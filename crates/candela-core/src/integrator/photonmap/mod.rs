@@ -143,6 +143,7 @@ impl Integrator for PhotonMapIntegrator {
         PassWork {
             units: self.settings.photons + self.settings.caustic_photons,
             unit: "photons",
+            light_paths: 0,
         }
     }
 

@@ -135,6 +135,7 @@ impl Integrator for SppmIntegrator {
         PassWork {
             units: self.settings.photons(ctx.film.pixel_count()),
             unit: "photons",
+            light_paths: 0,
         }
     }
 

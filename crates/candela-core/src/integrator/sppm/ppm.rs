@@ -70,6 +70,7 @@ impl Integrator for PpmIntegrator {
         PassWork {
             units: self.photons(ctx),
             unit: "photons",
+            light_paths: 0,
         }
     }
 

@@ -228,6 +228,7 @@ impl Integrator for VcmIntegrator {
         PassWork {
             units: self.light_paths(ctx) + cam,
             unit: "paths",
+            light_paths: self.light_paths(ctx),
         }
     }
 
