@@ -196,7 +196,10 @@ pub fn finish(
                 budget,
                 warnings,
             )?;
-            Box::new(SppmIntegrator { settings })
+            Box::new(SppmIntegrator {
+                settings,
+                visits: Default::default(),
+            })
         }
         Settings::Ppm(mut settings) => {
             settings.radius = radius(warnings);
@@ -209,7 +212,10 @@ pub fn finish(
                 budget,
                 warnings,
             )?;
-            Box::new(PpmIntegrator { settings })
+            Box::new(PpmIntegrator {
+                settings,
+                visits: Default::default(),
+            })
         }
         Settings::Vcm(mut settings) => {
             settings.radius = radius(warnings);

@@ -30,7 +30,7 @@ pub use ppm::{ppm_radius2, PpmIntegrator, PpmSettings};
 use super::photon::ShootSettings;
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
-use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list};
+use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, PixelVisit, VisitBuffer};
 
 /// α of the radius reduction (Hachisuka & Jensen recommend 2/3).
 pub const ALPHA: f64 = 2.0 / 3.0;
@@ -67,6 +67,45 @@ impl Default for SppmSettings {
 pub struct SppmIntegrator {
     /// Settings.
     pub settings: SppmSettings,
+    /// The camera pass's visits, reused between passes.
+    pub visits: VisitBuffer,
+}
+
+impl SppmIntegrator {
+    /// One iteration: the camera pass into `visits`, the photon pass, and
+    /// the per-pixel radius and flux update (see the module doc).
+    fn iteration(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: u64,
+        st: &mut SppmState,
+        visits: &mut Vec<PixelVisit>,
+    ) -> PassOutcome {
+        let s = &self.settings;
+        let pixels = pixel_list(ctx.film);
+        let pw = pass_wavelengths(s.seed, pass, s.wavelength_groups);
+        if camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth, visits).is_none() {
+            return PassOutcome::Cancelled;
+        }
+        let visits: &[PixelVisit] = visits;
+        let radius: Vec<f32> = st.stats.iter().map(|p| p.r2.sqrt() as f32).collect();
+        let n = st.photons_per_iteration;
+        let Some(gathered) = photon_pass(ctx, visits, &radius, &pw, &s.shoot(), pass, n) else {
+            return PassOutcome::Cancelled;
+        };
+        for ((p, v), g) in st.stats.iter_mut().zip(visits).zip(&gathered) {
+            let ld = ctx.film.sensor().to_sensor_rgb(v.ld, &v.lambda);
+            for (sum, v) in p.ld.iter_mut().zip(ld) {
+                *sum += v as f64;
+            }
+            let phi = match &v.vp {
+                Some(vp) if g.m > 0 => ctx.film.sensor().to_sensor_rgb(vp.beta * g.phi, &v.lambda),
+                _ => [0.0; 3],
+            };
+            *p = sppm_update(p, g.m as f64, phi.map(|v| v as f64), ALPHA);
+        }
+        PassOutcome::Done
+    }
 }
 
 /// Per-pixel statistics of SPPM.
@@ -163,29 +202,7 @@ impl Integrator for SppmIntegrator {
         let IntegratorState::Sppm(st) = state else {
             return PassOutcome::Cancelled;
         };
-        let s = &self.settings;
-        let pixels = pixel_list(ctx.film);
-        let pw = pass_wavelengths(s.seed, pass, s.wavelength_groups);
-        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth) else {
-            return PassOutcome::Cancelled;
-        };
-        let radius: Vec<f32> = st.stats.iter().map(|p| p.r2.sqrt() as f32).collect();
-        let n = st.photons_per_iteration;
-        let Some(gathered) = photon_pass(ctx, &visits, &radius, &pw, &s.shoot(), pass, n) else {
-            return PassOutcome::Cancelled;
-        };
-        for ((p, v), g) in st.stats.iter_mut().zip(&visits).zip(&gathered) {
-            let ld = ctx.film.sensor().to_sensor_rgb(v.ld, &v.lambda);
-            for (sum, v) in p.ld.iter_mut().zip(ld) {
-                *sum += v as f64;
-            }
-            let phi = match &v.vp {
-                Some(vp) if g.m > 0 => ctx.film.sensor().to_sensor_rgb(vp.beta * g.phi, &v.lambda),
-                _ => [0.0; 3],
-            };
-            *p = sppm_update(p, g.m as f64, phi.map(|v| v as f64), ALPHA);
-        }
-        PassOutcome::Done
+        self.iteration(ctx, pass, st, &mut self.visits.lock())
     }
 
     /// L = Ld/I + τ/(I·N_p·πR²) after I iterations of N_p photons.

@@ -72,6 +72,18 @@ pub struct PixelVisit {
     pub vp: Option<VisiblePoint>,
 }
 
+impl PixelVisit {
+    /// A pixel that saw nothing (yet).
+    fn none(lambda: &SampledWavelengths, group: usize) -> Self {
+        PixelVisit {
+            ld: SampledSpectrum::zero(),
+            lambda: *lambda,
+            group,
+            vp: None,
+        }
+    }
+}
+
 /// Pixels of the film's bounds in scanline order.
 pub fn pixel_list(film: &Film) -> Vec<UVec2> {
     let (lo, hi) = film.pixel_bounds();
@@ -80,44 +92,52 @@ pub fn pixel_list(film: &Film) -> Vec<UVec2> {
         .collect()
 }
 
-/// Pixels per parallel chunk of the camera pass.
-const PIXEL_CHUNK: usize = 256;
+/// The camera pass's output, kept from pass to pass: at 240 bytes a pixel
+/// it is 42 MB for a 350×500 film, above glibc's largest mmap threshold
+/// (32 MB), so a fresh vector each pass came from a fresh mapping and paid
+/// ~10 000 page faults (and their zeroing) per pass.
+#[derive(Debug, Default)]
+pub struct VisitBuffer(std::sync::Mutex<Vec<PixelVisit>>);
 
-/// The camera pass of iteration `iter`, each pixel at its group's
-/// wavelengths in `pw` (`None` if the render was cancelled meanwhile).
+impl VisitBuffer {
+    /// The buffer (passes run one at a time; a poisoned lock only means an
+    /// earlier pass panicked, and the camera pass refills the buffer anyway).
+    pub fn lock(&self) -> std::sync::MutexGuard<'_, Vec<PixelVisit>> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// The camera pass of iteration `iter` into `visits` (one per pixel), each
+/// pixel at its group's wavelengths in `pw` (`None` if the render was
+/// cancelled meanwhile). The sampler is reset at every pixel, so the
+/// visits do not depend on how the work is split between threads.
 pub fn camera_pass(
     ctx: &RenderContext<'_>,
     pixels: &[UVec2],
     iter: u32,
     pw: &PassWavelengths,
     max_depth: u32,
-) -> Option<Vec<PixelVisit>> {
-    let chunks: Vec<Option<Vec<PixelVisit>>> = pixels
-        .par_chunks(PIXEL_CHUNK)
+    visits: &mut Vec<PixelVisit>,
+) -> Option<()> {
+    pixels
+        .par_iter()
         .enumerate()
-        .map(|(c, chunk)| {
-            if ctx.cancelled() {
-                return None;
-            }
-            let mut sampler = ctx.sampler.clone();
-            Some(
-                chunk
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &pixel)| {
-                        let group = pw.pixel_group((c * PIXEL_CHUNK + k) as u64);
-                        sampler.start_pixel_sample(pixel, iter, 0);
-                        let lambda = pw.group(group);
-                        let mut v = visit_pixel(ctx, pixel, lambda, max_depth, &mut sampler);
-                        v.group = group;
-                        v
-                    })
-                    .collect(),
-            )
-        })
-        .collect();
-    let chunks: Option<Vec<Vec<PixelVisit>>> = chunks.into_iter().collect();
-    Some(chunks?.into_iter().flatten().collect())
+        .map_init(
+            || ctx.sampler.clone(),
+            |sampler, (i, &pixel)| {
+                let group = pw.pixel_group(i as u64);
+                let lambda = pw.group(group);
+                if ctx.cancelled() {
+                    return PixelVisit::none(lambda, group);
+                }
+                sampler.start_pixel_sample(pixel, iter, 0);
+                let mut v = visit_pixel(ctx, pixel, lambda, max_depth, sampler);
+                v.group = group;
+                v
+            },
+        )
+        .collect_into_vec(visits);
+    (!ctx.cancelled()).then_some(())
 }
 
 /// The camera walk of one pixel: direct light on the way and the visible
@@ -129,12 +149,7 @@ fn visit_pixel(
     max_depth: u32,
     sampler: &mut Sampler,
 ) -> PixelVisit {
-    let mut visit = PixelVisit {
-        ld: SampledSpectrum::zero(),
-        lambda: *lambda,
-        group: 0,
-        vp: None,
-    };
+    let mut visit = PixelVisit::none(lambda, 0);
     let Some(cs) = camera_sample(ctx, pixel, sampler) else {
         return visit;
     };

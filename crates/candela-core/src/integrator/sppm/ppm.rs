@@ -9,7 +9,9 @@
 //! channels, which the film averages over passes; because the passes are
 //! independent, a render can be split into pass ranges and merged exactly.
 
-use super::passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list};
+use super::passes::{
+    camera_pass, pass_wavelengths, photon_pass, pixel_list, PixelVisit, VisitBuffer,
+};
 use super::ALPHA;
 use crate::film::PassBlock;
 use crate::integrator::photon::ShootSettings;
@@ -37,6 +39,8 @@ pub struct PpmSettings {
 pub struct PpmIntegrator {
     /// Settings.
     pub settings: PpmSettings,
+    /// The camera pass's visits, reused between passes.
+    pub visits: VisitBuffer,
 }
 
 /// r²_i / r²_1 for pass `i` ≥ 1: Π_{k=1}^{i−1} (k + α)/(k + 1).
@@ -90,18 +94,19 @@ impl Integrator for PpmIntegrator {
             caustic_only: false,
         };
         let pw = pass_wavelengths(st.seed, pass, st.wavelength_groups);
-        let Some(visits) = camera_pass(ctx, &pixels, pass as u32, &pw, st.max_depth) else {
+        let mut guard = self.visits.lock();
+        if camera_pass(ctx, &pixels, pass as u32, &pw, st.max_depth, &mut guard).is_none() {
             return PassOutcome::Cancelled;
-        };
+        }
+        let visits: &[PixelVisit] = &guard;
         let r2 = self.radius2(pass);
         let radius = vec![r2.sqrt() as f32; pixels.len()];
-        let Some(gathered) = photon_pass(ctx, &visits, &radius, &pw, &shoot, pass, n_photons)
-        else {
+        let Some(gathered) = photon_pass(ctx, visits, &radius, &pw, &shoot, pass, n_photons) else {
             return PassOutcome::Cancelled;
         };
         let norm = (1.0 / (n_photons as f64 * std::f64::consts::PI * r2)) as f32;
         let mut buf = ctx.film.splat_buffer();
-        for ((pixel, v), g) in pixels.iter().zip(&visits).zip(&gathered) {
+        for ((pixel, v), g) in pixels.iter().zip(visits).zip(&gathered) {
             let mut l = v.ld;
             if let Some(vp) = &v.vp {
                 if g.m > 0 {
