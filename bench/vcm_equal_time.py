@@ -24,7 +24,8 @@ is L S D S E).
 Output (in --out, default target/vcm-bench/): results.md (a markdown table:
 error, passes and light paths/s per scene, integrator and time; the stored
 light vertex's size in bytes and the vertices stored per vcm iteration), and
-error_vs_time.png, a log-log plot of relMSE against render time per scene.
+error_vs_time.png, log-log plots of relMSE and MAE against render time per
+scene (relMSE is dominated by rare bright paths; MAE shows the bulk).
 The plot needs matplotlib; when the running Python has none, the script
 creates a virtual environment target/vcm-bench/venv (shared by all runs) and pip-installs
 matplotlib there (printing that it does; `--no-plot` skips it). Nothing else
@@ -87,12 +88,14 @@ def render(scene, integrator, seconds, out, threads, seed):
     return int(m.group(1)), float(m.group(4)), m.group("status") or ""
 
 
-def rel_mse(img, ref):
+def errors(img, ref):
+    """relMSE (eps 0.01) and MAE of `img` against `ref` (`candela diff`)."""
     out = subprocess.run([BIN, "diff", img, ref], capture_output=True, text=True)
     m = re.search(r"relMSE \(eps [^)]*\)\s+([0-9.eE+-]+|inf|nan)", out.stdout)
-    if out.returncode != 0 or not m:
+    mae = re.search(r"MAE\s+([0-9.eE+-]+|inf|nan)", out.stdout)
+    if out.returncode != 0 or not m or not mae:
         sys.exit(f"candela diff {img} {ref} failed:\n{out.stdout}{out.stderr}")
-    return float(m.group(1))
+    return float(m.group(1)), float(mae.group(1))
 
 
 def film_pixels(scene):
@@ -127,11 +130,11 @@ def bench_scene(name, a, outdir, rows, vertex_info):
                 t = a.t0 * 2 ** k
                 img = os.path.join(outdir, f"{name}-x{a.scale}-{integ}-{t:g}s.exr")
                 passes, secs, status = render(scene, integ, t, img, a.threads, 1 + k)
-                err = rel_mse(img, ref)
+                err, mae = errors(img, ref)
                 lps = passes * pixels * LIGHT_PATHS_PER_PIXEL.get(integ, 0) / secs if secs > 0 else 0
-                rows.append((name, integ, t, passes, secs, err, lps))
+                rows.append((name, integ, t, passes, secs, err, lps, mae))
                 print(f"{name:14} {integ:5} t={t:<6g} passes {passes:6} render {secs:7.2f} s "
-                      f"relMSE {err:.5g}  light paths/s {lps:.3g}", flush=True)
+                      f"relMSE {err:.5g} MAE {mae:.4g} light paths/s {lps:.3g}", flush=True)
                 v = re.search(r"(\d+) light vertices stored × (\d+) B", status)
                 if integ == "vcm" and v:
                     vertex_info[name] = (int(v.group(1)), int(v.group(2)), pixels)
@@ -143,11 +146,11 @@ def bench_scene(name, a, outdir, rows, vertex_info):
 def table(rows, vertex_info, a):
     lines = [f"# Equal-time relMSE (scale {a.scale}, reference {a.ref_integrator} "
              f"{a.ref_seconds:g} s{', QUICK: not the real bench' if a.quick else ''})", "",
-             "| scene | integrator | time limit s | passes | render s | relMSE | light paths/s |",
-             "|---|---|---|---|---|---|---|"]
-    for name, integ, t, passes, secs, err, lps in rows:
+             "| scene | integrator | time limit s | passes | render s | relMSE | MAE | light paths/s |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, integ, t, passes, secs, err, lps, mae in rows:
         lp = f"{lps:.3g}" if lps else "-"
-        lines.append(f"| {name} | {integ} | {t:g} | {passes} | {secs:.2f} | {err:.4g} | {lp} |")
+        lines.append(f"| {name} | {integ} | {t:g} | {passes} | {secs:.2f} | {err:.4g} | {mae:.4g} | {lp} |")
     lines += ["", "## vcm: stored light vertices (last iteration of the longest run)", "",
               "| scene | light paths / iteration | vertices stored | bytes / vertex | MB / iteration |",
               "|---|---|---|---|---|"]
@@ -158,7 +161,7 @@ def table(rows, vertex_info, a):
               "|---|---|---|---|---|"]
     tmax = a.t0 * 2 ** (a.steps - 1)
     for name in a.scenes:
-        at = {i: e for (s, i, t, _, _, e, _) in rows if s == name and t == tmax}
+        at = {r[1]: r[5] for r in rows if r[0] == name and r[2] == tmax}
         if "vcm" not in at or len(at) < 2:
             continue
         best = min((e, i) for i, e in at.items() if i != "vcm")
@@ -188,15 +191,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 rows, out, title = json.load(open(sys.argv[1])), sys.argv[2], sys.argv[3]
 scenes = list(dict.fromkeys(r[0] for r in rows))
-fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4), squeeze=False)
-for ax, s in zip(axes[0], scenes):
-    for integ in dict.fromkeys(r[1] for r in rows if r[0] == s):
-        pts = sorted((r[4], r[5]) for r in rows if r[0] == s and r[1] == integ and r[5] > 0)
-        if pts:
-            ax.loglog(*zip(*pts), marker="o", label=integ)
-    ax.set_title(s); ax.set_xlabel("render time [s]"); ax.set_ylabel("relMSE"); ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-fig.suptitle(title); fig.tight_layout(); fig.savefig(out, dpi=110)
+fig, axes = plt.subplots(2, len(scenes), figsize=(5 * len(scenes), 8), squeeze=False)
+for col, s in enumerate(scenes):
+    for row, (k, label) in enumerate([(5, "relMSE"), (7, "MAE")]):
+        ax = axes[row][col]
+        for integ in dict.fromkeys(r[1] for r in rows if r[0] == s):
+            pts = sorted((r[4], r[k]) for r in rows if r[0] == s and r[1] == integ and r[k] > 0)
+            if pts:
+                ax.loglog(*zip(*pts), marker="o", label=integ)
+        ax.set_title(s); ax.set_xlabel("render time [s]"); ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3); ax.legend()
+fig.suptitle(title); fig.tight_layout(); fig.savefig(out, dpi=100)
 '''
 
 
@@ -241,7 +246,7 @@ def main():
     print(md)
     print(f"table: {os.path.join(a.out, 'results.md')}")
     if not a.no_plot:
-        print(f"plot: {plot(rows, a.out, 'relMSE vs time' + (' (quick)' if a.quick else ''))}")
+        print(f"plot: {plot(rows, a.out, 'error vs time' + (' (quick)' if a.quick else ''))}")
 
 
 if __name__ == "__main__":

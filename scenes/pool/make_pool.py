@@ -130,7 +130,11 @@ Film "rgb" "integer xresolution" [{xres}] "integer yresolution" [{yres}]
     "string filename" "pool.exr"
 PixelFilter "box"
 Sampler "independent" "integer pixelsamples" [64]
-Integrator "vcm" "integer maxdepth" [8]
+# candela: render with --integrator vcm. pbrt-v4 has no vcm, so the file names
+# sppm, which both renderers have and which converges on L S D S E paths
+# (candela derives its radius from the scene; pbrt-v4's default radius, 1 m,
+# is coarse here: add "float radius" [0.03] for it).
+Integrator "sppm" "integer maxdepth" [8]
 
 WorldBegin
 

@@ -185,7 +185,7 @@ fn pool_small(integrator: &str) -> String {
             "\"integer xresolution\" [64] \"integer yresolution\" [48]",
         )
         .replace(
-            "Integrator \"vcm\" \"integer maxdepth\" [8]",
+            "Integrator \"sppm\" \"integer maxdepth\" [8]",
             &format!("Integrator {integrator} \"integer maxdepth\" [5]"),
         );
     assert!(
