@@ -386,7 +386,7 @@ fn report(
     // radius, VCM's stored light vertices).
     let status = setup
         .integrator
-        .status(&state.integrator_state, (done as u64).saturating_sub(1))
+        .status(&state.integrator_state, done.saturating_sub(1))
         .map_or(String::new(), |s| format!(" ({s})"));
     eprintln!(
         "candela: {} with {done} of {} passes{why}{status}: load {:.2} s, render {:.2} s; wrote {}{}",
