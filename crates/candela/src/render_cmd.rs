@@ -381,10 +381,16 @@ fn report(
         StopReason::TimeLimit => " (time limit)".into(),
         StopReason::TargetError(e) => format!(" (relative error {e:.2e} reached)"),
     };
+    let done = state.film.passes().count();
+    // The integrator's status at the last pass rendered (its iteration and
+    // radius, VCM's stored light vertices).
+    let status = setup
+        .integrator
+        .status(&state.integrator_state, done.saturating_sub(1))
+        .map_or(String::new(), |s| format!(" ({s})"));
     eprintln!(
-        "candela: {} with {} of {} passes{why}: load {:.2} s, render {:.2} s; wrote {}{}",
+        "candela: {} with {done} of {} passes{why}{status}: load {:.2} s, render {:.2} s; wrote {}{}",
         setup.integrator.kind(),
-        state.film.passes().count(),
         state.total_passes,
         load.as_secs_f64(),
         outcome.elapsed.as_secs_f64(),

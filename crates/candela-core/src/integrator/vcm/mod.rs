@@ -60,7 +60,14 @@ use crate::math::Ray;
 use crate::sampling::hash_u64s;
 use crate::spatial::HashGrid;
 use camera::CameraPass;
+use light::LightVertex;
 use mis::Factors;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Memory of one stored light vertex in bytes (position, normals, BSDF,
+/// β, MIS quantities: [`LightVertex`]); an iteration stores
+/// about N_light × (mean non-specular light-subpath length) of them.
+pub const LIGHT_VERTEX_BYTES: usize = std::mem::size_of::<LightVertex>();
 
 /// Which estimator the one VCM loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,6 +168,9 @@ pub struct VcmIntegrator {
     /// Settings.
     pub settings: VcmSettings,
     techniques: Techniques,
+    /// Light vertices the last finished light pass stored (for the status
+    /// line only; the image never depends on it).
+    stored: AtomicU64,
 }
 
 impl VcmIntegrator {
@@ -170,6 +180,7 @@ impl VcmIntegrator {
         Self {
             settings,
             techniques,
+            stored: AtomicU64::new(0),
         }
     }
 
@@ -250,6 +261,8 @@ impl Integrator for VcmIntegrator {
         let Some(light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
             return PassOutcome::Cancelled;
         };
+        self.stored
+            .store(light.vertices.len() as u64, Ordering::Relaxed);
         for b in &light.splats {
             block.add_splats(b);
         }
@@ -281,10 +294,18 @@ impl Integrator for VcmIntegrator {
     }
 
     fn status(&self, _state: &IntegratorState, next_pass: u64) -> Option<String> {
-        Some(format!(
+        let mut s = format!(
             "iteration {}, radius {:.4}",
             next_pass + 1,
             self.radius(next_pass)
-        ))
+        );
+        let stored = self.stored.load(Ordering::Relaxed);
+        if stored > 0 {
+            s.push_str(&format!(
+                ", {stored} light vertices stored × {LIGHT_VERTEX_BYTES} B = {:.1} MB",
+                (stored * LIGHT_VERTEX_BYTES as u64) as f64 / 1e6
+            ));
+        }
+        Some(s)
     }
 }

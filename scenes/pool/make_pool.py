@@ -1,0 +1,196 @@
+#!/usr/bin/env python3
+"""Writes scenes/pool/scene.pbrt: caustics on a pool floor seen through water.
+
+    python3 scenes/pool/make_pool.py [--n 40] [--out scenes/pool/scene.pbrt]
+
+Pure Python, no dependencies; the generated file is committed so the scene
+works from a fresh clone. Geometry (scene units = metres):
+
+- the pool: a 3 x 3 basin, x, z in [-1.5, 1.5], floor at y = 0, four walls up
+  to the deck at y = 1.3, a deck ring around it (all diffuse; the floor and
+  walls a checkerboard of tiles, planar-mapped);
+- the water: an *open* heightfield sheet, y = 1 + h(x, z), h a sum of four
+  sines (amplitudes 2.6-4.5 cm, wavelengths 0.6-1.1 m, directions spread over the circle so the crests cross in a network), an (n+1)^2 vertex
+  grid spanning the basin wall to wall, with analytic per-vertex normals.
+  The sheet is open because the basin closes the water: below the sheet
+  there is only water, bounded by the opaque floor and walls, so every path
+  leaves the water through the sheet. Triangles are wound so the geometric
+  normal (p0 - p2) x (p1 - p2) points up (+y, into the air), the same side
+  as the shading normals: the dielectric's outside (eta 1) is the air;
+- the light: a small spherical area light (radius 4 cm) 4 m above the
+  water, so the caustics are sharp but still reachable by paths that hit the
+  light (a point light would make L S D S E unrenderable by any unbiased
+  estimator);
+- the camera: above the deck, looking down through the water at the floor.
+
+The focal length of a sine crest of amplitude A and wave number k under a
+surface of index 1.33 is about 1.33 / (0.33 A k^2); the waves are chosen so
+that it is of the order of the water's depth (1 m), which puts the bright
+caustic network on the floor.
+"""
+import argparse
+import math
+import os
+
+WAVES = [  # (amplitude, wavelength, direction angle in degrees, phase)
+    (0.045, 1.10, 15.0, 0.0),
+    (0.036, 0.85, 77.0, 1.3),
+    (0.030, 0.70, 141.0, 2.1),
+    (0.026, 0.60, 253.0, 0.4),
+]
+HALF = 1.5  # half width of the basin
+WATER = 1.0  # mean water level
+DECK = 1.3  # top of the walls
+
+
+def height(x, z):
+    h = 0.0
+    for a, lam, deg, ph in WAVES:
+        k = 2.0 * math.pi / lam
+        dx, dz = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+        h += a * math.sin(k * (dx * x + dz * z) + ph)
+    return h
+
+
+def normal(x, z):
+    """Unit normal of y = WATER + h(x, z): (-dh/dx, 1, -dh/dz), normalised."""
+    gx = gz = 0.0
+    for a, lam, deg, ph in WAVES:
+        k = 2.0 * math.pi / lam
+        dx, dz = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+        c = a * k * math.cos(k * (dx * x + dz * z) + ph)
+        gx += c * dx
+        gz += c * dz
+    ln = math.sqrt(gx * gx + 1.0 + gz * gz)
+    return (-gx / ln, 1.0 / ln, -gz / ln)
+
+
+def fmt(vals):
+    return " ".join(f"{v:.6g}" for v in vals)
+
+
+def water_mesh(n):
+    pts, nrm, idx = [], [], []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            x = -HALF + 2.0 * HALF * i / n
+            z = -HALF + 2.0 * HALF * j / n
+            pts += [x, WATER + height(x, z), z]
+            nrm += list(normal(x, z))
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            b, c, d = a + 1, a + n + 2, a + n + 1
+            # (a, c, b) and (a, d, c): (p0 - p2) x (p1 - p2) points to +y.
+            idx += [a, c, b, a, d, c]
+    return pts, nrm, idx
+
+
+def quad(p, facing):
+    """A two-triangle mesh of corners p[0..3] (in order around the quad),
+    wound so that its geometric normal points along `facing`."""
+    a, b, c = p[0], p[1], p[2]
+    u = [a[i] - c[i] for i in range(3)]
+    v = [b[i] - c[i] for i in range(3)]
+    n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+    idx = [0, 1, 2, 0, 2, 3]
+    if sum(n[i] * facing[i] for i in range(3)) < 0:
+        idx = [0, 2, 1, 0, 3, 2]
+    flat = [c for q in p for c in q]
+    return f'Shape "trianglemesh" "point3 P" [{fmt(flat)}] "integer indices" [{fmt(idx)}]'
+
+
+def basin():
+    h, d = HALF, DECK
+    return [
+        quad([(-h, 0, -h), (h, 0, -h), (h, 0, h), (-h, 0, h)], (0, 1, 0)),  # floor
+        quad([(-h, 0, -h), (h, 0, -h), (h, d, -h), (-h, d, -h)], (0, 0, 1)),
+        quad([(-h, 0, h), (h, 0, h), (h, d, h), (-h, d, h)], (0, 0, -1)),
+        quad([(-h, 0, -h), (-h, 0, h), (-h, d, h), (-h, d, -h)], (1, 0, 0)),
+        quad([(h, 0, -h), (h, 0, h), (h, d, h), (h, d, -h)], (-1, 0, 0)),
+    ]
+
+
+def deck():
+    h, d, w = HALF, DECK, HALF + 0.4
+    return [
+        quad([(-w, d, -w), (w, d, -w), (w, d, -h), (-w, d, -h)], (0, 1, 0)),
+        quad([(-w, d, h), (w, d, h), (w, d, w), (-w, d, w)], (0, 1, 0)),
+        quad([(-w, d, -h), (-h, d, -h), (-h, d, h), (-w, d, h)], (0, 1, 0)),
+        quad([(h, d, -h), (w, d, -h), (w, d, h), (h, d, h)], (0, 1, 0)),
+    ]
+
+
+HEADER = """# The pool: caustics of a small light on a tiled pool floor, seen from above
+# through a wavy water surface (L S D S E paths). Generated by make_pool.py;
+# edit that and rerun it rather than this file.
+LookAt 0.3 4.4 -2.4   0 0 0.15   0 1 0
+Camera "perspective" "float fov" [44]
+Film "rgb" "integer xresolution" [{xres}] "integer yresolution" [{yres}]
+    "string filename" "pool.exr"
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" [64]
+# candela: render with --integrator vcm. pbrt-v4 has no vcm, so the file names
+# sppm, which both renderers have and which converges on L S D S E paths
+# (candela derives its radius from the scene; pbrt-v4's default radius, 1 m,
+# is coarse here: add "float radius" [0.03] for it).
+Integrator "sppm" "integer maxdepth" [8]
+
+WorldBegin
+
+AttributeBegin
+    Translate 0.9 5.0 1.6
+    AreaLightSource "diffuse" "rgb L" [8000 7600 6800]
+    Material "diffuse" "rgb reflectance" [0 0 0]
+    Shape "sphere" "float radius" [0.04]
+AttributeEnd
+
+# Pool tiles: 0.25 m squares, planar-mapped on the floor (x, z); the walls
+# (planar in x, y and z, y) get a coarser uniform tile colour.
+Texture "tiles" "spectrum" "checkerboard" "string mapping" "planar"
+    "vector3 v1" [4 0 0] "vector3 v2" [0 0 4]
+    "rgb tex1" [0.80 0.84 0.86] "rgb tex2" [0.55 0.72 0.80]
+AttributeBegin
+    Material "diffuse" "texture reflectance" "tiles"
+    {floor}
+AttributeEnd
+AttributeBegin
+    Material "diffuse" "rgb reflectance" [0.45 0.62 0.72]
+    {walls}
+AttributeEnd
+AttributeBegin
+    Material "diffuse" "rgb reflectance" [0.35 0.33 0.3]
+    {deck}
+AttributeEnd
+
+# The water: an open heightfield sheet (see make_pool.py), normals up.
+AttributeBegin
+    Material "dielectric" "float eta" [1.33]
+    Shape "trianglemesh"
+        "point3 P" [{p}]
+        "normal N" [{n}]
+        "integer indices" [{i}]
+AttributeEnd
+"""
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    here = os.path.dirname(os.path.abspath(__file__))
+    ap.add_argument("--n", type=int, default=48, help="water grid cells per side")
+    ap.add_argument("--xres", type=int, default=320)
+    ap.add_argument("--yres", type=int, default=240)
+    ap.add_argument("--out", default=os.path.join(here, "scene.pbrt"))
+    a = ap.parse_args()
+    p, n, i = water_mesh(a.n)
+    b = basin()
+    text = HEADER.format(
+        xres=a.xres, yres=a.yres, floor=b[0], walls="\n    ".join(b[1:]),
+        deck="\n    ".join(deck()), p=fmt(p), n=fmt(n), i=fmt(i))
+    with open(a.out, "w") as f:
+        f.write(text)
+    print(f"{a.out}: {2 * a.n * a.n} water triangles")
+
+
+if __name__ == "__main__":
+    main()
