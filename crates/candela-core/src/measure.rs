@@ -29,7 +29,8 @@ use crate::interaction::Interaction;
 use crate::light::LightSampleContext;
 use crate::math::{Frame, Ray, Vec3, PI};
 use crate::sampling::sample_cosine_hemisphere;
-use crate::spectrum::{cie_xyz, SampledSpectrum, SampledWavelengths, K_M};
+pub(crate) use crate::spectrum::luminous;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::UVec2;
 
 /// Settings of a measurement.
@@ -58,32 +59,15 @@ pub fn measure_point(
     p: Vec3,
     n: Vec3,
 ) -> Measurement {
-    let scene = ctx.scene;
-    let path = PathIntegrator {
-        settings: PathSettings {
-            max_depth: settings.max_depth,
-            regularize: false,
-        },
-    };
-    let b = scene.bounds();
-    let size = if b.min.x <= b.max.x {
-        (b.max - b.min).length()
-    } else {
-        1.0
-    };
-    let origin = p + n * (1e-5 * size.max(1e-3));
-    let frame = Frame::from_z(n);
+    let path = meter_path(settings.max_depth);
+    let origin = sensor_origin(ctx.scene, p, n);
     let mut sampler = ctx.sampler.clone();
     let mut splats = SplatBuffer::empty_at(UVec2::ZERO, ctx.film);
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for s in 0..settings.samples {
         sampler.start_pixel_sample(UVec2::new(index, 0), s, 0);
-        let mut lambda = SampledWavelengths::sample_visible(sampler.get_1d());
-        let mut e = delta_irradiance(ctx, origin, n, &lambda, sampler.get_2d());
-        let wi = frame.from_local(sample_cosine_hemisphere(sampler.get_2d()));
-        let ray = Ray::new(origin, wi);
-        e += path.li(ctx, ray, &mut lambda, &mut sampler, &mut splats) * PI;
-        let y = luminous(&e, &lambda);
+        let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
+        let y = illuminance_sample(ctx, &path, origin, n, lambda, &mut sampler, &mut splats);
         sum += y;
         sum2 += y * y;
     }
@@ -98,6 +82,50 @@ pub fn measure_point(
         illuminance: mean,
         stderr: (var / n).sqrt(),
     }
+}
+
+/// The path tracer of the "everything a ray can find" part, without
+/// regularisation, following at most `max_depth` scattering events.
+pub(crate) fn meter_path(max_depth: u32) -> PathIntegrator {
+    PathIntegrator {
+        settings: PathSettings {
+            max_depth,
+            regularize: false,
+        },
+    }
+}
+
+/// Where the rays of a sensor at `p` facing unit `n` start: `p` moved along
+/// `n` by 10⁻⁵ of the scene's size (see the module doc).
+pub(crate) fn sensor_origin(scene: &crate::scene::Scene, p: Vec3, n: Vec3) -> Vec3 {
+    let b = scene.bounds();
+    let size = if b.min.x <= b.max.x {
+        (b.max - b.min).length()
+    } else {
+        1.0
+    };
+    p + n * (1e-5 * size.max(1e-3))
+}
+
+/// One sample of E_v [lx] at `origin` on a sensor facing unit `n`, at the
+/// wavelengths `lambda`, drawing the rest from `sampler` (already started
+/// at its sample): the delta-light part and the cosine-weighted path
+/// estimate of the module doc. `candela measure` averages these per point;
+/// the photometric film takes one per pass at each pixel's first hit
+/// ([`crate::render::surface`]).
+pub(crate) fn illuminance_sample(
+    ctx: &RenderContext<'_>,
+    path: &PathIntegrator,
+    origin: Vec3,
+    n: Vec3,
+    mut lambda: SampledWavelengths,
+    sampler: &mut crate::sampler::Sampler,
+    splats: &mut SplatBuffer,
+) -> f64 {
+    let mut e = delta_irradiance(ctx, origin, n, &lambda, sampler.get_2d());
+    let wi = Frame::from_z(n).from_local(sample_cosine_hemisphere(sampler.get_2d()));
+    e += path.li(ctx, Ray::new(origin, wi), &mut lambda, sampler, splats) * PI;
+    luminous(&e, &lambda)
 }
 
 /// Σ over delta lights of their unoccluded Li·cos θ at `origin` facing `n`.
@@ -125,15 +153,4 @@ fn delta_irradiance(
         }
     }
     e
-}
-
-/// K_m·(1/N) Σ_k ȳ(λ_k)·e_k/p(λ_k) [lx]; terminated wavelengths (pdf 0) count 0.
-pub(crate) fn luminous(e: &SampledSpectrum, lambda: &SampledWavelengths) -> f64 {
-    let pdf = lambda.pdf();
-    let n = lambda.lambdas().len();
-    let y: f64 = (0..n)
-        .filter(|&k| pdf[k] > 0.0)
-        .map(|k| cie_xyz(lambda.lambda(k))[1] as f64 * e[k] as f64 / pdf[k] as f64)
-        .sum();
-    K_M as f64 * y / n as f64
 }
