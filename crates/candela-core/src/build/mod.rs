@@ -143,16 +143,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .with_illuminance_depth(plan.max_depth.saturating_sub(1));
     claim_film(desc, &film, &mut budget)?;
     let kind = plan.kind();
-    if kind == IntegratorKind::Sppm && film.layout().photometric {
-        return Err(BuildError::Other(
-            "--units photometric needs independent passes for its standard errors; SPPM's iterations depend on each other (use ppm)".into(),
-        ));
-    }
-    if kind == IntegratorKind::LightPath && !camera.is_connectable() {
-        return Err(BuildError::Other(
-            "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
-        ));
-    }
+    check_combination(kind, &film, &camera)?;
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
     let geometry::Built {
         prims,
@@ -203,6 +194,21 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         warnings,
         budget,
     })
+}
+
+/// Refuses integrators that cannot render this film or camera.
+fn check_combination(kind: IntegratorKind, film: &Film, camera: &Camera) -> Result<(), BuildError> {
+    if kind == IntegratorKind::Sppm && film.layout().photometric {
+        return Err(BuildError::Other(
+            "--units photometric needs independent passes for its standard errors; SPPM's iterations depend on each other (use ppm)".into(),
+        ));
+    }
+    if kind == IntegratorKind::LightPath && !camera.is_connectable() {
+        return Err(BuildError::Other(
+            "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// The film with `n` strategy layers added (BDPT's visualisation).

@@ -84,7 +84,7 @@ pub fn colour(t: f64) -> [u8; 3] {
 
 /// Where `v` sits on the scale ending at `max` (> 0).
 pub fn position(v: f64, scale: FalseColorScale, max: f64) -> f64 {
-    if !(v > 0.0) {
+    if v.is_nan() || v <= 0.0 {
         return 0.0;
     }
     let t = match scale {
