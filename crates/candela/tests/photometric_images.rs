@@ -316,3 +316,48 @@ fn sppm_and_unknown_units_are_refused_with_a_message() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn a_photometric_render_stopped_early_resumes_to_the_bytes_of_one_run() {
+    // --time-limit stops after the first pass (it always runs one) and
+    // writes the state; --resume adds the other passes in fixed point.
+    let d = dir("resume");
+    let s = d.join("s.pbrt");
+    std::fs::write(&s, t5_floor(0.5, 12, 6)).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_candela"))
+            .arg("render")
+            .arg(&s)
+            .args([
+                "--units",
+                "photometric",
+                "--quiet",
+                "--seed",
+                "5",
+                "--outfile",
+            ])
+            .arg(d.join(out))
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run("whole.exr", &[]);
+    run("stopped.exr", &["--time-limit", "0.000001"]);
+    let stopped = read_exr_layers(&d.join("stopped.exr")).unwrap();
+    assert_eq!(
+        stopped.attributes.get("candela.passes"),
+        Some(&ExrAttribute::Int(1))
+    );
+    let ckpt = d.join("stopped.cndl");
+    run("resumed.exr", &["--resume", ckpt.to_str().unwrap()]);
+    let bytes = |n: &str| std::fs::read(d.join(n)).unwrap();
+    assert!(bytes("resumed.exr") == bytes("whole.exr"), "EXR differs");
+    for png in ["luminance.png", "illuminance.png"] {
+        assert!(
+            bytes(&format!("resumed.{png}")) == bytes(&format!("whole.{png}")),
+            "{png} differs"
+        );
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
