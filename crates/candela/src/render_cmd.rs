@@ -272,6 +272,24 @@ fn outfile_origin(args: &RenderArgs, desc: &SceneDescription) -> String {
     }
 }
 
+/// Refuses false-colour flags without photometric layers; prints the
+/// build's warnings and one about standard errors of a single pass.
+fn check_units(args: &RenderArgs, setup: &RenderSetup) -> Result<()> {
+    let photometric = setup.film.layout().photometric;
+    if args.falsecolor_max.is_some() && !photometric {
+        bail!(
+            "--falsecolor-max needs --units photometric (the false-colour PNGs are of its layers)"
+        );
+    }
+    for w in &setup.warnings {
+        eprintln!("candela: warning: {w}");
+    }
+    if photometric && setup.sampler.samples_per_pixel() < 2 {
+        eprintln!("candela: warning: --units photometric with 1 pass: the standard-error layers need 2 passes and are 0");
+    }
+    Ok(())
+}
+
 /// `candela render`; returns the exit code.
 pub fn render(args: RenderArgs) -> Result<i32> {
     if let Some(n) = args.nthreads {
@@ -288,9 +306,7 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     let ov = args.overrides();
     let desc = candela_scene::parse_file(&args.scene)?;
     let setup = build(&desc, &ov)?;
-    for w in &setup.warnings {
-        eprintln!("candela: warning: {w}");
-    }
+    check_units(&args, &setup)?;
     let exr = output::checked_exr(&setup.outfile, &outfile_origin(&args, &desc))?;
     let (mut state, opts, partial) = plan(&args, &desc, &setup, &ov, &exr)?;
     let checkpoint = opts.checkpoint.clone().unwrap_or_default();
