@@ -12,7 +12,16 @@
 //!   after any number of bounces, including delta lights seen through
 //!   diffuse reflection): one cosine-weighted direction ω, p(ω) = cos θ/π,
 //!   and the path tracer's radiance estimate L̂(ω), which contributes π·L̂
-//!   [pbrt-v4 §13.4]. Its depth limit is [`MeasureSettings::max_depth`].
+//!   [pbrt-v4 §13.4]. Its depth limit is [`MeasureSettings::max_depth`];
+//! - **light sampling at the sensor** for the area and infinite lights
+//!   the cosine ray could hit directly: one light chosen by the scene's
+//!   light sampler (pmf P), a direction on it (density p_l), contributing
+//!   L·cos θ/(P·p_l) weighted by the power heuristic against the cosine
+//!   density, while the emission the cosine ray finds at its first hit
+//!   takes the complementary weight [Veach 1997, eq. 9.13]
+//!   ([`PathIntegrator::li_sampled`]); lights no ray can hit (an area
+//!   light of `alpha` 0) take full weight. Small luminaires are then found
+//!   by their samples, not by chance.
 //!
 //! Wavelengths are sampled as for the camera (`sample_visible`) and V(λ)
 //! weighs each: Ŷ = (1/N) Σ_k ȳ(λ_k)·Ê(λ_k)/p(λ_k), E_v = K_m·Ŷ. The
@@ -23,12 +32,11 @@
 //! distance along n (10⁻⁵ of the scene's size), so a point on a surface
 //! measures what arrives there from the side n faces.
 
-use crate::film::SplatBuffer;
-use crate::integrator::{PathIntegrator, PathSettings, PixelEstimator, RenderContext};
+use crate::integrator::{PathIntegrator, PathSettings, RenderContext};
 use crate::interaction::Interaction;
 use crate::light::LightSampleContext;
 use crate::math::{Frame, Ray, Vec3, PI};
-use crate::sampling::sample_cosine_hemisphere;
+use crate::sampling::{power_heuristic, sample_cosine_hemisphere};
 pub(crate) use crate::spectrum::luminous;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::UVec2;
@@ -62,12 +70,11 @@ pub fn measure_point(
     let path = meter_path(settings.max_depth);
     let origin = sensor_origin(ctx.scene, p, n);
     let mut sampler = ctx.sampler.clone();
-    let mut splats = SplatBuffer::empty_at(UVec2::ZERO, ctx.film);
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for s in 0..settings.samples {
         sampler.start_pixel_sample(UVec2::new(index, 0), s, 0);
         let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
-        let y = illuminance_sample(ctx, &path, origin, n, lambda, &mut sampler, &mut splats);
+        let y = illuminance_sample(ctx, &path, origin, n, lambda, &mut sampler);
         sum += y;
         sum2 += y * y;
     }
@@ -120,12 +127,53 @@ pub(crate) fn illuminance_sample(
     n: Vec3,
     mut lambda: SampledWavelengths,
     sampler: &mut crate::sampler::Sampler,
-    splats: &mut SplatBuffer,
 ) -> f64 {
     let mut e = delta_irradiance(ctx, origin, n, &lambda, sampler.get_2d());
+    let (u_light, u) = (sampler.get_1d(), sampler.get_2d());
+    e += light_irradiance(ctx, origin, n, &lambda, u_light, u);
     let wi = Frame::from_z(n).from_local(sample_cosine_hemisphere(sampler.get_2d()));
-    e += path.li(ctx, Ray::new(origin, wi), &mut lambda, sampler, splats) * PI;
+    let pdf = wi.dot(n).max(0.0) / PI;
+    e += path.li_sampled(ctx, Ray::new(origin, wi), pdf, &mut lambda, sampler) * PI;
     luminous(&e, &lambda)
+}
+
+/// One MIS-weighted light sample of the hittable (non-delta) lights'
+/// L·cos θ at `origin` facing `n` (see the module doc).
+fn light_irradiance(
+    ctx: &RenderContext<'_>,
+    origin: Vec3,
+    n: Vec3,
+    lambda: &SampledWavelengths,
+    u_light: f32,
+    u: crate::math::Vec2,
+) -> SampledSpectrum {
+    let scene = ctx.scene;
+    let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
+        return SampledSpectrum::zero();
+    };
+    let light = scene.light(id);
+    if light.light_type().is_delta() {
+        // Counted, every sample, by `delta_irradiance`.
+        return SampledSpectrum::zero();
+    }
+    let lsc = LightSampleContext::at_point(origin);
+    let Some(ls) = light.sample_li(&lsc, u, lambda) else {
+        return SampledSpectrum::zero();
+    };
+    let cos = ls.wi.dot(n);
+    let p_l = pmf * ls.pdf.0;
+    if cos <= 0.0 || ls.l.is_black() || p_l <= 0.0 {
+        return SampledSpectrum::zero();
+    }
+    if !scene.unoccluded(&Interaction::at_point(origin), &ls.p_light) {
+        return SampledSpectrum::zero();
+    }
+    let w = if light.is_hittable() {
+        power_heuristic(1.0, p_l, 1.0, cos / PI)
+    } else {
+        1.0
+    };
+    ls.l * (cos * w / p_l)
 }
 
 /// Σ over delta lights of their unoccluded Li·cos θ at `origin` facing `n`.

@@ -79,13 +79,11 @@ pub fn render_surface_pass(
     let tiles = for_each_tile(ctx, |lo, hi| {
         let mut tile = ctx.film.tile(lo, hi);
         let mut sampler = ctx.sampler.clone();
-        let mut splats = crate::film::SplatBuffer::empty_at(lo, ctx.film);
         let mut cx = PixelContext {
             ctx,
             camera_from_world: &camera_from_world,
             meter: &meter,
             sampler: &mut sampler,
-            splats: &mut splats,
         };
         for y in lo.y..hi.y {
             for x in lo.x..hi.x {
@@ -113,7 +111,6 @@ struct PixelContext<'a, 'c> {
     camera_from_world: &'a Transform,
     meter: &'a PathIntegrator,
     sampler: &'a mut Sampler,
-    splats: &'a mut crate::film::SplatBuffer,
 }
 
 impl PixelContext<'_, '_> {
@@ -149,7 +146,7 @@ impl PixelContext<'_, '_> {
         let e = layout.photometric.then(|| {
             let n = face_forward(si.n(), si.wo).normalize_or_zero();
             let origin = measure::sensor_origin(ctx.scene, si.p(), n);
-            measure::illuminance_sample(ctx, self.meter, origin, n, lambda, sampler, self.splats)
+            measure::illuminance_sample(ctx, self.meter, origin, n, lambda, sampler)
         });
         Some((s, e, fs.weight))
     }
