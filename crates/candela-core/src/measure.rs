@@ -12,7 +12,16 @@
 //!   after any number of bounces, including delta lights seen through
 //!   diffuse reflection): one cosine-weighted direction ω, p(ω) = cos θ/π,
 //!   and the path tracer's radiance estimate L̂(ω), which contributes π·L̂
-//!   [pbrt-v4 §13.4]. Its depth limit is [`MeasureSettings::max_depth`].
+//!   [pbrt-v4 §13.4]. Its depth limit is [`MeasureSettings::max_depth`];
+//! - **light sampling at the sensor** for the area and infinite lights
+//!   the cosine ray could hit directly: one light chosen by the scene's
+//!   light sampler (pmf P), a direction on it (density p_l), contributing
+//!   L·cos θ/(P·p_l) weighted by the power heuristic against the cosine
+//!   density, while the emission the cosine ray finds at its first hit
+//!   takes the complementary weight [Veach 1997, eq. 9.13]
+//!   ([`PathIntegrator::li_sampled`]); lights no ray can hit (an area
+//!   light of `alpha` 0) take full weight. Small luminaires are then found
+//!   by their samples, not by chance.
 //!
 //! Wavelengths are sampled as for the camera (`sample_visible`) and V(λ)
 //! weighs each: Ŷ = (1/N) Σ_k ȳ(λ_k)·Ê(λ_k)/p(λ_k), E_v = K_m·Ŷ. The
@@ -23,13 +32,13 @@
 //! distance along n (10⁻⁵ of the scene's size), so a point on a surface
 //! measures what arrives there from the side n faces.
 
-use crate::film::SplatBuffer;
-use crate::integrator::{PathIntegrator, PathSettings, PixelEstimator, RenderContext};
+use crate::integrator::{PathIntegrator, PathSettings, RenderContext};
 use crate::interaction::Interaction;
 use crate::light::LightSampleContext;
 use crate::math::{Frame, Ray, Vec3, PI};
-use crate::sampling::sample_cosine_hemisphere;
-use crate::spectrum::{cie_xyz, SampledSpectrum, SampledWavelengths, K_M};
+use crate::sampling::{power_heuristic, sample_cosine_hemisphere};
+pub(crate) use crate::spectrum::luminous;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use glam::UVec2;
 
 /// Settings of a measurement.
@@ -58,32 +67,14 @@ pub fn measure_point(
     p: Vec3,
     n: Vec3,
 ) -> Measurement {
-    let scene = ctx.scene;
-    let path = PathIntegrator {
-        settings: PathSettings {
-            max_depth: settings.max_depth,
-            regularize: false,
-        },
-    };
-    let b = scene.bounds();
-    let size = if b.min.x <= b.max.x {
-        (b.max - b.min).length()
-    } else {
-        1.0
-    };
-    let origin = p + n * (1e-5 * size.max(1e-3));
-    let frame = Frame::from_z(n);
+    let path = meter_path(settings.max_depth);
+    let origin = sensor_origin(ctx.scene, p, n);
     let mut sampler = ctx.sampler.clone();
-    let mut splats = SplatBuffer::empty_at(UVec2::ZERO, ctx.film);
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for s in 0..settings.samples {
         sampler.start_pixel_sample(UVec2::new(index, 0), s, 0);
-        let mut lambda = SampledWavelengths::sample_visible(sampler.get_1d());
-        let mut e = delta_irradiance(ctx, origin, n, &lambda, sampler.get_2d());
-        let wi = frame.from_local(sample_cosine_hemisphere(sampler.get_2d()));
-        let ray = Ray::new(origin, wi);
-        e += path.li(ctx, ray, &mut lambda, &mut sampler, &mut splats) * PI;
-        let y = luminous(&e, &lambda);
+        let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
+        let y = illuminance_sample(ctx, &path, origin, n, lambda, &mut sampler);
         sum += y;
         sum2 += y * y;
     }
@@ -98,6 +89,91 @@ pub fn measure_point(
         illuminance: mean,
         stderr: (var / n).sqrt(),
     }
+}
+
+/// The path tracer of the "everything a ray can find" part, without
+/// regularisation, following at most `max_depth` scattering events.
+pub(crate) fn meter_path(max_depth: u32) -> PathIntegrator {
+    PathIntegrator {
+        settings: PathSettings {
+            max_depth,
+            regularize: false,
+        },
+    }
+}
+
+/// Where the rays of a sensor at `p` facing unit `n` start: `p` moved along
+/// `n` by 10⁻⁵ of the scene's size (see the module doc).
+pub(crate) fn sensor_origin(scene: &crate::scene::Scene, p: Vec3, n: Vec3) -> Vec3 {
+    let b = scene.bounds();
+    let size = if b.min.x <= b.max.x {
+        (b.max - b.min).length()
+    } else {
+        1.0
+    };
+    p + n * (1e-5 * size.max(1e-3))
+}
+
+/// One sample of E_v [lx] at `origin` on a sensor facing unit `n`, at the
+/// wavelengths `lambda`, drawing the rest from `sampler` (already started
+/// at its sample): the delta-light part and the cosine-weighted path
+/// estimate of the module doc. `candela measure` averages these per point;
+/// the photometric film takes one per pass at each pixel's first hit
+/// ([`crate::render::surface`]).
+pub(crate) fn illuminance_sample(
+    ctx: &RenderContext<'_>,
+    path: &PathIntegrator,
+    origin: Vec3,
+    n: Vec3,
+    mut lambda: SampledWavelengths,
+    sampler: &mut crate::sampler::Sampler,
+) -> f64 {
+    let mut e = delta_irradiance(ctx, origin, n, &lambda, sampler.get_2d());
+    let (u_light, u) = (sampler.get_1d(), sampler.get_2d());
+    e += light_irradiance(ctx, origin, n, &lambda, u_light, u);
+    let wi = Frame::from_z(n).from_local(sample_cosine_hemisphere(sampler.get_2d()));
+    let pdf = wi.dot(n).max(0.0) / PI;
+    e += path.li_sampled(ctx, Ray::new(origin, wi), pdf, &mut lambda, sampler) * PI;
+    luminous(&e, &lambda)
+}
+
+/// One MIS-weighted light sample of the hittable (non-delta) lights'
+/// L·cos θ at `origin` facing `n` (see the module doc).
+fn light_irradiance(
+    ctx: &RenderContext<'_>,
+    origin: Vec3,
+    n: Vec3,
+    lambda: &SampledWavelengths,
+    u_light: f32,
+    u: crate::math::Vec2,
+) -> SampledSpectrum {
+    let scene = ctx.scene;
+    let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
+        return SampledSpectrum::zero();
+    };
+    let light = scene.light(id);
+    if light.light_type().is_delta() {
+        // Counted, every sample, by `delta_irradiance`.
+        return SampledSpectrum::zero();
+    }
+    let lsc = LightSampleContext::at_point(origin);
+    let Some(ls) = light.sample_li(&lsc, u, lambda) else {
+        return SampledSpectrum::zero();
+    };
+    let cos = ls.wi.dot(n);
+    let p_l = pmf * ls.pdf.0;
+    if cos <= 0.0 || ls.l.is_black() || p_l <= 0.0 {
+        return SampledSpectrum::zero();
+    }
+    if !scene.unoccluded(&Interaction::at_point(origin), &ls.p_light) {
+        return SampledSpectrum::zero();
+    }
+    let w = if light.is_hittable() {
+        power_heuristic(1.0, p_l, 1.0, cos / PI)
+    } else {
+        1.0
+    };
+    ls.l * (cos * w / p_l)
 }
 
 /// Σ over delta lights of their unoccluded Li·cos θ at `origin` facing `n`.
@@ -125,15 +201,4 @@ fn delta_irradiance(
         }
     }
     e
-}
-
-/// K_m·(1/N) Σ_k ȳ(λ_k)·e_k/p(λ_k) [lx]; terminated wavelengths (pdf 0) count 0.
-pub(crate) fn luminous(e: &SampledSpectrum, lambda: &SampledWavelengths) -> f64 {
-    let pdf = lambda.pdf();
-    let n = lambda.lambdas().len();
-    let y: f64 = (0..n)
-        .filter(|&k| pdf[k] > 0.0)
-        .map(|k| cie_xyz(lambda.lambda(k))[1] as f64 * e[k] as f64 / pdf[k] as f64)
-        .sum();
-    K_M as f64 * y / n as f64
 }

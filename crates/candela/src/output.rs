@@ -1,9 +1,11 @@
 //! Writing a developed film: the EXR (every layer, the number of passes in
-//! the header), a tone-mapped PNG beside it, BDPT's strategy images, all
-//! through temporary files renamed into place.
+//! the header), a tone-mapped PNG beside it (for photometric films instead
+//! false-colour PNGs of luminance and illuminance with legends), BDPT's
+//! strategy images, all through temporary files renamed into place.
 
 use anyhow::{bail, Context, Result};
 use candela_core::film::Developed;
+use candela_core::image::falsecolor::{self, FalseColorScale};
 use candela_core::image::{write_exr_layers, ExrAttributes};
 use candela_core::render;
 use std::path::{Path, PathBuf};
@@ -53,16 +55,44 @@ pub fn checked_exr(outfile: &Path, origin: &str) -> Result<PathBuf> {
     Ok(exr)
 }
 
-/// Writes the developed image as `exr` (every layer) and a PNG beside it,
-/// and the strategy images (`names[k]`) in the same directory.
+/// How the false-colour PNGs of photometric films are drawn.
+#[derive(Clone, Copy, Debug)]
+pub struct FalseColor {
+    /// Log or linear.
+    pub scale: FalseColorScale,
+    /// Top of the scale (default: automatic per picture).
+    pub max: Option<f64>,
+}
+
+/// Writes `OUTFILE.<layer>.png` for the luminance and illuminance layers.
+fn write_falsecolor(dev: &Developed, exr: &Path, fc: &FalseColor) -> Result<()> {
+    for (layer, unit) in [("luminance", "cd/m²"), ("illuminance", "lx")] {
+        let Some(values) = dev.channel(&format!("{layer}.Y")) else {
+            continue;
+        };
+        let max = fc.max.unwrap_or_else(|| falsecolor::auto_max(values));
+        let pic = falsecolor::render(values, dev.width, dev.height, unit, fc.scale, max);
+        falsecolor::write_png(&pic, &exr.with_extension(format!("{layer}.png")))?;
+    }
+    Ok(())
+}
+
+/// Writes the developed image as `exr` (every layer) and a PNG beside it
+/// (false-colour PNGs for photometric films), and the strategy images
+/// (`names[k]`) in the same directory.
 pub fn write(
     dev: &Developed,
     exr: &Path,
     attrs: &ExrAttributes,
     strategy_names: &[Option<String>],
+    fc: &FalseColor,
 ) -> Result<()> {
     write_exr_layers(exr, dev.width, dev.height, &render::exr_layers(dev), attrs)?;
-    dev.rgb().write_png(&exr.with_extension("png"), 0.0)?;
+    if dev.units.is_empty() {
+        dev.rgb().write_png(&exr.with_extension("png"), 0.0)?;
+    } else {
+        write_falsecolor(dev, exr, fc)?;
+    }
     let dir = exr.parent().unwrap_or(Path::new(""));
     for (img, name) in dev.strategies.iter().zip(strategy_names) {
         if let Some(name) = name {

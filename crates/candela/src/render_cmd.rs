@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use candela_core::build::{build, Overrides, RenderSetup};
 use candela_core::film::develop::develop;
 use candela_core::film::Aov;
+use candela_core::image::falsecolor::FalseColorScale;
 use candela_core::integrator::{IntegratorKind, Visualize};
 use candela_core::render::{self, RenderOptions, RenderState, StopReason};
 use candela_scene::SceneDescription;
@@ -128,6 +129,25 @@ pub struct RenderArgs {
     /// (s²/n; needs 2 passes).
     #[arg(long, value_parser = parse_aovs)]
     pub aov: Option<AovList>,
+    /// `sensor` (default): the film's sensor RGB. `photometric`: instead
+    /// of RGB, the EXR holds `luminance.Y` [cd/m²] (683 lm/W × ∫L V dλ,
+    /// CIE 1931 V = ȳ), `illuminance.Y` [lx] (arriving at the first visible
+    /// surface of each pixel, from the side the camera sees; 0 where the
+    /// ray escapes; Radiance's `rpict -i`) and their standard errors
+    /// `luminance_stderr.Y`, `illuminance_stderr.Y` (√(s²/n) over the
+    /// passes; needs 2), with the units in the header (`<layer>.units`);
+    /// false-colour PNGs OUTFILE.luminance.png and OUTFILE.illuminance.png
+    /// with a legend replace the tone-mapped PNG. Every integrator but sppm.
+    #[arg(long, value_parser = parse_units, default_value = "sensor")]
+    pub units: Units,
+    /// Scale of the false-colour PNGs (`--units photometric`): `log`
+    /// (default; 3 decades below the maximum) or `linear` (0 to the maximum).
+    #[arg(long, default_value = "log")]
+    pub falsecolor_scale: FalseColorScale,
+    /// Top of the false-colour scale in cd/m² and lx (default: per
+    /// picture, the smallest 1, 2 or 5 × 10^k above the 99th percentile).
+    #[arg(long, value_parser = parse_positive)]
+    pub falsecolor_max: Option<f64>,
     /// Show the image in the tev viewer listening at HOST:PORT while it
     /// renders (tev's default is 127.0.0.1:14158): every channel of the
     /// EXR, at most 4 frames a second, never blocking the render; the
@@ -139,6 +159,32 @@ pub struct RenderArgs {
     /// default: 75% of physical memory).
     #[arg(long, value_parser = candela_core::build::parse_memory)]
     pub memory_limit: Option<u64>,
+}
+
+/// Parses a positive finite number.
+fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a positive number, found {s:?}")),
+    }
+}
+
+/// What the film records (`--units`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Units {
+    /// Sensor RGB.
+    Sensor,
+    /// Luminance and illuminance with standard errors.
+    Photometric,
+}
+
+/// Parses `--units`.
+fn parse_units(s: &str) -> Result<Units, String> {
+    match s {
+        "sensor" => Ok(Units::Sensor),
+        "photometric" => Ok(Units::Photometric),
+        _ => Err(format!("expected sensor or photometric, found {s:?}")),
+    }
 }
 
 /// The layers of `--aov` (one value to clap, not a list of values).
@@ -161,6 +207,7 @@ impl RenderArgs {
             cropwindow: self.cropwindow,
             aovs: self.aov.clone().map(|a| a.0).unwrap_or_default(),
             memory_limit: self.memory_limit,
+            photometric: self.units == Units::Photometric,
         }
     }
 }
@@ -197,14 +244,19 @@ fn strategy_names(setup: &RenderSetup) -> Vec<Option<String>> {
         .unwrap_or_default()
 }
 
-/// Develops `state` and writes the image files.
-fn write_image(setup: &RenderSetup, state: &RenderState, exr: &Path) -> Result<()> {
+/// Develops `state` and writes the image files, the false-colour ones with `fc`.
+fn write_image(
+    setup: &RenderSetup,
+    state: &RenderState,
+    exr: &Path,
+    fc: &output::FalseColor,
+) -> Result<()> {
     let overlay = setup
         .integrator
         .develop_overlay(&state.integrator_state, state.film.passes().count());
     let dev = develop(&setup.film, &state.film, overlay.as_deref());
     let attrs = render::exr_attributes(&dev, &state.integrator, state.total_passes);
-    output::write(&dev, exr, &attrs, &strategy_names(setup))
+    output::write(&dev, exr, &attrs, &strategy_names(setup), fc)
 }
 
 /// Where the output path came from, to start errors about it: the flag, or
@@ -218,6 +270,24 @@ fn outfile_origin(args: &RenderArgs, desc: &SceneDescription) -> String {
         Some(loc) => format!("{loc}: Film \"filename\""),
         None => "the default output file (no --outfile, no Film \"filename\")".into(),
     }
+}
+
+/// Refuses false-colour flags without photometric layers; prints the
+/// build's warnings and one about standard errors of a single pass.
+fn check_units(args: &RenderArgs, setup: &RenderSetup) -> Result<()> {
+    let photometric = setup.film.layout().photometric;
+    if args.falsecolor_max.is_some() && !photometric {
+        bail!(
+            "--falsecolor-max needs --units photometric (the false-colour PNGs are of its layers)"
+        );
+    }
+    for w in &setup.warnings {
+        eprintln!("candela: warning: {w}");
+    }
+    if photometric && setup.sampler.samples_per_pixel() < 2 {
+        eprintln!("candela: warning: --units photometric with 1 pass: the standard-error layers need 2 passes and are 0");
+    }
+    Ok(())
 }
 
 /// `candela render`; returns the exit code.
@@ -236,9 +306,7 @@ pub fn render(args: RenderArgs) -> Result<i32> {
     let ov = args.overrides();
     let desc = candela_scene::parse_file(&args.scene)?;
     let setup = build(&desc, &ov)?;
-    for w in &setup.warnings {
-        eprintln!("candela: warning: {w}");
-    }
+    check_units(&args, &setup)?;
     let exr = output::checked_exr(&setup.outfile, &outfile_origin(&args, &desc))?;
     let (mut state, opts, partial) = plan(&args, &desc, &setup, &ov, &exr)?;
     let checkpoint = opts.checkpoint.clone().unwrap_or_default();
@@ -259,7 +327,11 @@ pub fn render(args: RenderArgs) -> Result<i32> {
         }
     })?;
     let live_report = live.map(|l| l.finish(&setup, &state));
-    write_image(&setup, &state, &exr)?;
+    let fc = output::FalseColor {
+        scale: args.falsecolor_scale,
+        max: args.falsecolor_max,
+    };
+    write_image(&setup, &state, &exr, &fc)?;
     let stopped_early = outcome.reason != StopReason::Finished;
     let write_state = partial.is_some() || args.checkpoint.is_some() || stopped_early;
     if write_state {
@@ -413,6 +485,12 @@ pub struct MergeArgs {
     /// Also write the merged state here (to merge or resume it further).
     #[arg(long)]
     pub checkpoint: Option<PathBuf>,
+    /// As for `render` (photometric parts).
+    #[arg(long, default_value = "log")]
+    pub falsecolor_scale: FalseColorScale,
+    /// As for `render` (photometric parts).
+    #[arg(long, value_parser = parse_positive)]
+    pub falsecolor_max: Option<f64>,
 }
 
 /// `candela merge`.
@@ -437,7 +515,11 @@ pub fn merge(args: MergeArgs) -> Result<()> {
             args.scene.display()
         );
     }
-    write_image(&setup, &total, &exr)?;
+    let fc = output::FalseColor {
+        scale: args.falsecolor_scale,
+        max: args.falsecolor_max,
+    };
+    write_image(&setup, &total, &exr, &fc)?;
     if let Some(c) = &args.checkpoint {
         total.save(c)?;
     }

@@ -44,18 +44,9 @@ fn measure(d: &Path, scene: &str, points: &str, extra: &[&str]) -> Vec<(f64, f64
 
 /// A closed 4 m cube of diffuse albedo `rho` around a 10 000 lm point light.
 fn cube(rho: f64) -> String {
-    let mut p = String::new();
-    for i in 0..8 {
-        let c = |b: i32| if i >> b & 1 == 1 { 2 } else { -2 };
-        p += &format!("{} {} {} ", c(0), c(1), c(2));
-    }
-    // Faces x−, x+, y−, y+, z−, z+ as two triangles each.
-    let idx = "0 2 6 0 6 4 1 5 7 1 7 3 0 4 5 0 5 1 2 3 7 2 7 6 0 1 3 0 3 2 4 6 7 4 7 5";
     format!(
-        "LookAt 0 0 1 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
-         LightSource \"point\" \"float lumens\" 10000 \"point3 from\" [0 0 0]\n\
-         Material \"diffuse\" \"spectrum reflectance\" [300 {rho} 800 {rho}]\n\
-         Shape \"trianglemesh\" \"point3 P\" [{p}] \"integer indices\" [{idx}]\n"
+        "LookAt 0 0 1 0 0 0 0 1 0\nCamera \"perspective\"\n{}",
+        common::t5_cube_world(rho)
     )
 }
 
@@ -102,10 +93,7 @@ fn floor_mean(e: &[(f64, f64)], r: f64) -> (f64, f64) {
     (scale * mean, scale * var.sqrt())
 }
 
-/// T5: Φ/(S(1 − ρ)) with S = 96 m².
-fn t5(rho: f64) -> f64 {
-    10_000.0 / (96.0 * (1.0 - rho))
-}
+use common::t5;
 
 /// Measures the three rooms with `extra` and checks ⟨E⟩ within 5σ + `bias`·truth.
 fn rooms(name: &str, r: f64, extra: &[&str], bias: f64) {

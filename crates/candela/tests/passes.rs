@@ -147,35 +147,52 @@ fn uneven_pass_ranges_merge_into_the_bytes_of_one_run_for_every_integrator() {
 }
 
 /// With layers (first-hit values, variance, spectral buckets, pbrt-v4's
-/// gbuffer) pass ranges still merge into the bytes of one run: the merge
-/// rebuilds the layers from the `aov=` setting stored in the parts.
+/// gbuffer, photometric luminance and illuminance with their standard
+/// errors) pass ranges still merge into the bytes of one run: the merge
+/// rebuilds the layers from the `aov=` and `units=` settings stored in the
+/// parts. Photometric renders write false-colour PNGs, which must match too.
 #[test]
 fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
-    let cases = [
+    let cases: [(&str, &str, &str, &[&str]); 6] = [
         (
             "aov-path",
             r#""path" "integer maxdepth" [5]"#,
             "rgb",
-            "albedo,depth,normal,uv,dzdxy,variance",
+            &["--aov", "albedo,depth,normal,uv,dzdxy,variance"],
         ),
         (
             "aov-ppm",
             INTEGRATORS[3].1,
             "rgb",
-            "position,shading_normal,variance",
+            &["--aov", "position,shading_normal,variance"],
         ),
-        ("gbuffer-bdpt", INTEGRATORS[2].1, "gbuffer", ""),
-        ("spectral-lightpath", INTEGRATORS[1].1, "spectral", "albedo"),
+        ("gbuffer-bdpt", INTEGRATORS[2].1, "gbuffer", &[]),
+        (
+            "spectral-lightpath",
+            INTEGRATORS[1].1,
+            "spectral",
+            &["--aov", "albedo"],
+        ),
+        (
+            "photometric-path",
+            r#""path" "integer maxdepth" [5]"#,
+            "rgb",
+            &["--units", "photometric", "--aov", "depth"],
+        ),
+        (
+            "photometric-lightpath",
+            INTEGRATORS[1].1,
+            "spectral",
+            &["--units", "photometric"],
+        ),
     ];
-    for (name, directive, film, aov) in cases {
+    for (name, directive, film, extra) in cases {
         let d = tmpdir(name);
         let s = d.join("s.pbrt");
         let text = scene(directive).replace(r#"Film "rgb""#, &format!(r#"Film "{film}""#));
         std::fs::write(&s, text).unwrap();
         let mut flags = vec!["--spp", "5"];
-        if !aov.is_empty() {
-            flags.extend(["--aov", aov]);
-        }
+        flags.extend(extra);
         run(&s, &flags, &d.join("full.exr"));
         for (a, b) in [(0, 2), (2, 5)] {
             let r = format!("{a}..{b}");
@@ -183,28 +200,43 @@ fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
             f.extend(["--pass-range", &r]);
             run(&s, &f, &d.join(format!("p{a}.exr")));
         }
-        let o = candela()
-            .arg("merge")
-            .arg(&s)
-            .args(["p2.passes-2-5.cndl", "p0.passes-0-2.cndl"].map(|p| d.join(p)))
-            .arg("-o")
-            .arg(d.join("merged.exr"))
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        let full = bytes(&d.join("full.exr"));
-        assert!(
-            bytes(&d.join("merged.exr")) == full,
-            "{name}: merged EXR differs from one run"
-        );
+        merge_equals_full(&d, &s, name);
         let layers = candela_core::image::read_exr_layers(&d.join("full.exr")).unwrap();
         assert!(layers.layers.len() > 1, "{name}: no layers written");
+        if extra.contains(&"photometric") {
+            assert!(layers.layer("illuminance_stderr").is_some(), "{name}");
+            for png in ["luminance.png", "illuminance.png"] {
+                assert!(
+                    bytes(&d.join(format!("merged.{png}")))
+                        == bytes(&d.join(format!("full.{png}"))),
+                    "{name}: {png} differs"
+                );
+            }
+        }
         std::fs::remove_dir_all(&d).ok();
     }
+}
+
+/// Merges the parts p0 (passes 0..2) and p2 (2..5) in `d` and checks the
+/// EXR equals `full.exr`.
+fn merge_equals_full(d: &Path, s: &Path, name: &str) {
+    let o = candela()
+        .arg("merge")
+        .arg(s)
+        .args(["p2.passes-2-5.cndl", "p0.passes-0-2.cndl"].map(|p| d.join(p)))
+        .arg("-o")
+        .arg(d.join("merged.exr"))
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        bytes(&d.join("merged.exr")) == bytes(&d.join("full.exr")),
+        "{name}: merged EXR differs from one run"
+    );
 }
 
 #[test]

@@ -147,7 +147,9 @@ fn film_layers(
             ))
         }
     };
-    Ok((layout.with_aovs(&ov.aovs), kind, space))
+    let mut layout = layout.with_aovs(&ov.aovs);
+    layout.photometric = ov.photometric;
+    Ok((layout, kind, space))
 }
 
 fn camera_exposure(desc: &SceneDescription) -> Result<f32, BuildError> {

@@ -46,6 +46,8 @@ pub struct Planned<'a> {
     pub power_sampling: bool,
     /// BDPT strategy layers the film must record (0 without visualisation).
     pub strategy_layers: usize,
+    /// `"integer maxdepth"` (every integrator reads it; pbrt-v4's default 5).
+    pub max_depth: u32,
 }
 
 /// Maps an integrator name to the estimator candela runs for it; the flag is
@@ -148,6 +150,7 @@ pub fn integrator<'a>(
         radius,
         power_sampling,
         strategy_layers,
+        max_depth: common.max_depth,
     })
 }
 

@@ -93,6 +93,9 @@ pub struct Overrides {
     pub cropwindow: Option<[f32; 4]>,
     /// `--aov`: extra film layers.
     pub aovs: Vec<crate::film::Aov>,
+    /// `--units photometric`: luminance [cd/m²] and first-hit illuminance
+    /// [lx] layers with their standard errors instead of sensor RGB.
+    pub photometric: bool,
     /// `--memory-limit` in bytes (default: [`budget::DEFAULT_SHARE`] of
     /// physical memory). Not part of a render's identity: it only decides
     /// whether the render may start.
@@ -133,14 +136,14 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
     let sampler = entities::sampler(desc, ov, &mut warnings)?;
     let default_integrator = default_entity("volpath");
     let plan = integrators::integrator(desc, ov, &default_integrator, &mut warnings)?;
-    let film = with_strategy_layers(film, plan.strategy_layers);
+    // The first-hit illuminance sees one scattering event fewer than the
+    // camera ray's path, whose first is at that hit (module doc of
+    // `render::surface`).
+    let film = with_strategy_layers(film, plan.strategy_layers)
+        .with_illuminance_depth(plan.max_depth.saturating_sub(1));
     claim_film(desc, &film, &mut budget)?;
     let kind = plan.kind();
-    if kind == IntegratorKind::LightPath && !camera.is_connectable() {
-        return Err(BuildError::Other(
-            "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
-        ));
-    }
+    check_combination(kind, &film, &camera)?;
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
     let geometry::Built {
         prims,
@@ -191,6 +194,21 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         warnings,
         budget,
     })
+}
+
+/// Refuses integrators that cannot render this film or camera.
+fn check_combination(kind: IntegratorKind, film: &Film, camera: &Camera) -> Result<(), BuildError> {
+    if kind == IntegratorKind::Sppm && film.layout().photometric {
+        return Err(BuildError::Other(
+            "--units photometric needs independent passes for its standard errors; SPPM's iterations depend on each other (use ppm)".into(),
+        ));
+    }
+    if kind == IntegratorKind::LightPath && !camera.is_connectable() {
+        return Err(BuildError::Other(
+            "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// The film with `n` strategy layers added (BDPT's visualisation).

@@ -75,13 +75,16 @@ impl PassBlock {
         self.dropped += tile.dropped;
     }
 
-    /// Adds a splat buffer to the direct channels of the main (and spectral) layer.
+    /// Adds a splat buffer to the direct channels of the main (spectral,
+    /// photometric) layers.
     pub fn add_splats(&mut self, buf: &SplatBuffer) {
         let nb = self.layout.n_buckets();
         let (direct, spectral) = (
             super::layout::MAIN_DIRECT,
             self.layout.spectral_direct_offset(),
         );
+        let luminance = buf.luminance.filter(|_| self.layout.photometric);
+        let dy = self.layout.photometric_offset() + super::layout::photo::DY;
         for i in 0..self.pixel_count() {
             let (row, src) = (i * self.stride, i * buf.stride);
             for k in 0..3 {
@@ -89,6 +92,9 @@ impl PassBlock {
             }
             for k in 0..nb.min(buf.stride - 3) {
                 self.rows[row + spectral + k] += buf.sums[src + 3 + k];
+            }
+            if let Some(o) = luminance {
+                self.rows[row + dy] += buf.sums[src + o];
             }
         }
         self.dropped += buf.dropped;

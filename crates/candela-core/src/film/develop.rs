@@ -14,6 +14,13 @@
 //! (pbrt-v4's per-sample variance, here per pass) and `RelativeVariance`
 //! s²/v̄²; candela's `variance` layer is s²/n, the variance of the pixel's
 //! estimate itself.
+//!
+//! Photometric films (`--units photometric`) have no R, G, B: their main
+//! layers are `luminance.Y` [cd/m²] (Σw·Y_v/Σw + Σdirect Y_v/n, see
+//! [`super::layout`]) and `illuminance.Y` [lx] (Σw_E·E_v/Σw_E), each with
+//! its standard error `luminance_stderr.Y`, `illuminance_stderr.Y` =
+//! √(s²/n) from the per-pass values (0 before 2 passes). The units are in
+//! [`Developed::units`], per layer, for the EXR header.
 
 use super::layout::{SurfaceAov, MAIN_DIRECT, MAIN_W, MAIN_WRGB};
 use super::{Film, FilmKind, FilmState};
@@ -41,18 +48,33 @@ pub struct Developed {
     pub channels: Vec<Channel>,
     /// BDPT strategy images in output RGB (empty unless the film records strategies).
     pub strategies: Vec<RgbImage>,
+    /// (layer, unit) of the layers in physical units (photometric films).
+    pub units: Vec<(String, &'static str)>,
 }
 
 impl Developed {
-    /// The main layer as an RGB image.
+    /// The main layer as an RGB image (black without R, G, B channels, as
+    /// for photometric films).
     pub fn rgb(&self) -> RgbImage {
         let mut img = RgbImage::new(self.width, self.height);
+        let planes = ["R", "G", "B"].map(|n| self.channel(n));
         for (i, p) in img.pixels.iter_mut().enumerate() {
-            *p = [0, 1, 2].map(|c| self.channels[c].data[i]);
+            *p = planes.map(|c| c.map_or(0.0, |d| d[i]));
         }
         img
     }
+
+    /// The samples of the channel named `name`.
+    pub fn channel(&self, name: &str) -> Option<&[f32]> {
+        let c = self.channels.iter().find(|c| c.name == name)?;
+        Some(&c.data)
+    }
 }
+
+/// Unit of the luminance layers.
+pub const LUMINANCE_UNIT: &str = "cd/m^2";
+/// Unit of the illuminance layers.
+pub const ILLUMINANCE_UNIT: &str = "lx";
 
 /// Develops `state`; `overlay`, if given, replaces the main layer's sensor
 /// RGB per pixel (SPPM, whose estimate is not a sum over passes).
@@ -82,14 +104,16 @@ pub fn develop(film: &Film, state: &FilmState, overlay: Option<&[[f64; 3]]>) -> 
             out.push((0..3).map(|c| m[r][c] * sensor[c]).sum::<f64>() as f32);
         }
     }
-    let mut channels: Vec<Channel> = ["R", "G", "B"]
-        .iter()
-        .zip(rgb)
-        .map(|(name, data)| Channel {
+    let mut channels: Vec<Channel> = Vec::new();
+    let mut units = Vec::new();
+    if film.layout().photometric {
+        units = photometric_channels(film, state, inv_n, &mut channels);
+    } else {
+        channels.extend(["R", "G", "B"].iter().zip(rgb).map(|(name, data)| Channel {
             name: name.to_string(),
             data,
-        })
-        .collect();
+        }));
+    }
     spectral_channels(film, state, inv_n, &mut channels);
     surface_channels(film, state, &mut channels);
     variance_channels(film, state, &mut channels);
@@ -99,7 +123,52 @@ pub fn develop(film: &Film, state: &FilmState, overlay: Option<&[[f64; 3]]>) -> 
         passes: n,
         channels,
         strategies: strategy_images(film, state, width, height, inv_n),
+        units,
     }
+}
+
+/// Luminance, illuminance and their standard errors; returns their units.
+fn photometric_channels(
+    film: &Film,
+    state: &FilmState,
+    inv_n: f64,
+    out: &mut Vec<Channel>,
+) -> Vec<(String, &'static str)> {
+    use super::layout::photo;
+    let layout = film.layout();
+    let (o, vo) = (
+        layout.photometric_offset(),
+        layout.photometric_variance_offset(),
+    );
+    let ratio = |a: f64, w: f64| if w != 0.0 { a / w } else { 0.0 };
+    let stderr = |i: usize, k: usize| {
+        let n = state.passes.count().max(1) as f64;
+        (pass_stats(state, i, vo + 2 * k, vo + 2 * k + 1).1 / n).sqrt()
+    };
+    out.push(per_pixel(state, "luminance.Y".into(), |i| {
+        ratio(state.value(i, o + photo::WY), state.value(i, MAIN_W))
+            + state.value(i, o + photo::DY) * inv_n
+    }));
+    out.push(per_pixel(state, "luminance_stderr.Y".into(), |i| {
+        stderr(i, 0)
+    }));
+    out.push(per_pixel(state, "illuminance.Y".into(), |i| {
+        ratio(
+            state.value(i, o + photo::WEE),
+            state.value(i, o + photo::WE),
+        )
+    }));
+    out.push(per_pixel(state, "illuminance_stderr.Y".into(), |i| {
+        stderr(i, 1)
+    }));
+    [
+        ("luminance", LUMINANCE_UNIT),
+        ("luminance_stderr", LUMINANCE_UNIT),
+        ("illuminance", ILLUMINANCE_UNIT),
+        ("illuminance_stderr", ILLUMINANCE_UNIT),
+    ]
+    .map(|(l, u)| (l.to_string(), u))
+    .to_vec()
 }
 
 /// Channels computed pixel by pixel from the state.
@@ -183,11 +252,11 @@ fn surface_channels(film: &Film, state: &FilmState, out: &mut Vec<Channel>) {
     }
 }
 
-/// (mean, sample variance) of the pass estimates of pixel `i`, channel `c`.
-fn pass_stats(state: &FilmState, i: usize, c: usize) -> (f64, f64) {
+/// (mean, sample variance) of the pass estimates of pixel `i` whose sum
+/// and sum of squares are state channels `c1` and `c2`.
+fn pass_stats(state: &FilmState, i: usize, c1: usize, c2: usize) -> (f64, f64) {
     let n = state.passes.count() as f64;
-    let o = state.layout.variance_offset();
-    let (s1, s2) = (state.value(i, o + c), state.value(i, o + 3 + c));
+    let (s1, s2) = (state.value(i, c1), state.value(i, c2));
     if n < 2.0 {
         return (s1 / n.max(1.0), 0.0);
     }
@@ -200,21 +269,23 @@ fn variance_channels(film: &Film, state: &FilmState, out: &mut Vec<Channel>) {
         return;
     }
     let n = state.passes.count().max(1) as f64;
+    let o = film.layout().variance_offset();
+    let rgb_stats = |i: usize, c: usize| pass_stats(state, i, o + c, o + 3 + c);
     for (c, ch) in ["R", "G", "B"].iter().enumerate() {
         if film.kind() == FilmKind::GBuffer {
             out.push(per_pixel(state, format!("Variance.{ch}"), |i| {
-                pass_stats(state, i, c).1
+                rgb_stats(i, c).1
             }));
         } else {
             out.push(per_pixel(state, format!("variance.{ch}"), |i| {
-                pass_stats(state, i, c).1 / n
+                rgb_stats(i, c).1 / n
             }));
         }
     }
     if film.kind() == FilmKind::GBuffer {
         for (c, ch) in ["R", "G", "B"].iter().enumerate() {
             out.push(per_pixel(state, format!("RelativeVariance.{ch}"), |i| {
-                let (mean, var) = pass_stats(state, i, c);
+                let (mean, var) = rgb_stats(i, c);
                 if mean != 0.0 {
                     var / (mean * mean)
                 } else {

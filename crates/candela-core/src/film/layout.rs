@@ -9,7 +9,9 @@
 //! | spectral | Σw·L̄_b, then Σdirect L̄_b, per bucket | Σw·L̄_b/Σw + Σdirect L̄_b/passes |
 //! | surface | Σw, then Σw·x for each requested first-hit value | Σw·x/Σw (normals normalised) |
 //! | strategies | Σdirect rgb (3) per BDPT strategy | Σ/passes |
+//! | photometric | Σw·Y_v, Σdirect Y_v, Σw_E, Σw_E·E_v | Σw·Y_v/Σw + Σdirect/passes [cd/m²]; Σw_E·E_v/Σw_E [lx] |
 //! | variance (state only) | Σv (3), Σv² (3) of per-pass pixel values v | see [`super::state`] |
+//! | photometric variance (state only) | Σv, Σv² of per-pass luminance, then of illuminance | √(s²/n) |
 //!
 //! "Weighted" channels hold filtered camera samples (pbrt-v4's
 //! `rgbSum`/`weightSum`); "direct" channels hold values that are already
@@ -23,6 +25,14 @@
 //! the main layer's weight Σw. (pbrt-v4's `SpectralFilm` samples λ
 //! uniformly and averages L per bucket with per-bucket weights; candela's
 //! integrators sample the visible-light density, hence the division by p.)
+//!
+//! The photometric group (`--units photometric`) holds the luminance
+//! Y_v = K_m·(1/N) Σ_i ȳ(λ_i)·L(λ_i)/p(λ_i) of each camera sample or splat
+//! (weighted like the main layer, sharing its Σw), and the illuminance E_v
+//! at the first visible surface of the pass's camera ray with that ray's
+//! filter weight w_E (the first-hit pass, [`crate::render::surface`]; rays
+//! that escape add w_E and no E_v). Its per-pass variance sums are always
+//! kept: every photometric value has its standard error.
 //!
 //! The surface group's weight Σw counts every camera sample of the
 //! first-hit pass, hits or not: a sample that escapes adds zeros, so, as
@@ -163,6 +173,24 @@ pub struct FilmLayout {
     pub variance: bool,
     /// Number of BDPT strategy layers (`visualizestrategies`/`visualizeweights`).
     pub strategies: usize,
+    /// Luminance and illuminance layers with their variance (`--units photometric`).
+    pub photometric: bool,
+}
+
+/// Offsets within the photometric group.
+pub mod photo {
+    /// Σw·Y_v of camera samples (weights are the main layer's Σw).
+    pub const WY: usize = 0;
+    /// Σ Y_v of direct values (splats, per-pass pixel estimates).
+    pub const DY: usize = 1;
+    /// Σw_E: filter weights of the first-hit rays.
+    pub const WE: usize = 2;
+    /// Σw_E·E_v.
+    pub const WEE: usize = 3;
+    /// Channels of the group in a pass block.
+    pub const WIDTH: usize = 4;
+    /// Channels of its variance sums in the state (Σv, Σv² of Y_v, then of E_v).
+    pub const VARIANCE_WIDTH: usize = 4;
 }
 
 /// Offsets of the main channels.
@@ -229,21 +257,42 @@ impl FilmLayout {
     pub fn strategy_offset(&self) -> usize {
         self.surface_offset() + self.surface_width()
     }
+    /// Offset of the photometric group.
+    pub fn photometric_offset(&self) -> usize {
+        self.strategy_offset() + 3 * self.strategies
+    }
     /// Channels of one pass-block pixel.
     pub fn pass_stride(&self) -> usize {
-        self.strategy_offset() + 3 * self.strategies
+        self.photometric_offset() + if self.photometric { photo::WIDTH } else { 0 }
     }
     /// Offset of the variance sums in a state pixel.
     pub fn variance_offset(&self) -> usize {
         self.pass_stride()
     }
+    /// Offset of the photometric variance sums in a state pixel.
+    pub fn photometric_variance_offset(&self) -> usize {
+        self.variance_offset() + if self.variance { 6 } else { 0 }
+    }
     /// Channels of one state pixel.
     pub fn state_stride(&self) -> usize {
-        self.pass_stride() + if self.variance { 6 } else { 0 }
+        self.photometric_variance_offset()
+            + if self.photometric {
+                photo::VARIANCE_WIDTH
+            } else {
+                0
+            }
+    }
+    /// True when the first-hit pass must run (surface values or illuminance).
+    pub fn needs_first_hit(&self) -> bool {
+        !self.surface.is_empty() || self.photometric
     }
     /// Fixed-point fraction bits of state channel `c`.
     pub fn bits(&self, c: usize) -> i32 {
-        if self.variance && c >= self.variance_offset() + 3 {
+        let v = self.variance_offset();
+        let pv = self.photometric_variance_offset();
+        let square = (self.variance && (v + 3..v + 6).contains(&c))
+            || (self.photometric && (c == pv + 1 || c == pv + 3));
+        if square {
             super::fixed::SQUARE_BITS
         } else {
             super::fixed::VALUE_BITS
@@ -266,6 +315,7 @@ mod tests {
             surface: vec![SurfaceAov::Albedo, SurfaceAov::Depth],
             variance: true,
             strategies: 2,
+            photometric: false,
         };
         assert_eq!(l.spectral_direct_offset(), 7 + 4);
         assert_eq!(l.surface_offset(), 7 + 8);
@@ -277,6 +327,22 @@ mod tests {
         assert_eq!(l.state_stride(), 32);
         assert_eq!(l.bits(28), super::super::fixed::VALUE_BITS);
         assert_eq!(l.bits(29), super::super::fixed::SQUARE_BITS);
+        let p = FilmLayout {
+            photometric: true,
+            ..l.clone()
+        };
+        assert_eq!(p.photometric_offset(), 26);
+        assert_eq!(p.pass_stride(), 30);
+        assert_eq!(p.variance_offset(), 30);
+        assert_eq!(p.photometric_variance_offset(), 36);
+        assert_eq!(p.state_stride(), 40);
+        let bits: Vec<i32> = (30..40).map(|c| p.bits(c)).collect();
+        let (v, s) = (
+            super::super::fixed::VALUE_BITS,
+            super::super::fixed::SQUARE_BITS,
+        );
+        assert_eq!(bits, [v, v, v, s, s, s, v, s, v, s]);
+        assert!(p.needs_first_hit() && !FilmLayout::default().needs_first_hit());
         let b = l.spectral.unwrap();
         assert_eq!(b.bucket(400.0), Some(0));
         assert_eq!(b.bucket(799.9), Some(3));

@@ -77,6 +77,7 @@ pub struct Film {
     kind: FilmKind,
     surface_space: SurfaceSpace,
     color_space: &'static ColorSpace,
+    illuminance_depth: u32,
 }
 
 impl Film {
@@ -97,7 +98,21 @@ impl Film {
             kind: FilmKind::Rgb,
             surface_space: SurfaceSpace::World,
             color_space: ColorSpace::srgb(),
+            illuminance_depth: 4,
         }
+    }
+
+    /// The same film whose first-hit illuminance estimates follow paths of
+    /// at most `depth` scattering events after the surface (photometric
+    /// layers; 4 by default, what a `maxdepth` 5 camera path leaves).
+    pub fn with_illuminance_depth(mut self, depth: u32) -> Self {
+        self.illuminance_depth = depth;
+        self
+    }
+
+    /// Scattering events after the surface of the first-hit illuminance estimate.
+    pub fn illuminance_depth(&self) -> u32 {
+        self.illuminance_depth
     }
 
     /// The same film with output colour space `cs` (whose illuminant and
@@ -173,12 +188,14 @@ impl Film {
             sensor: self.sensor.clone(),
             max_component_value: self.settings.max_component_value,
             buckets: self.layout.spectral,
+            luminance: self.layout.photometric,
         }
     }
 
     pub(crate) fn encoder_for_empty(&self) -> Encoder {
         Encoder {
             buckets: None,
+            luminance: false,
             ..self.encoder()
         }
     }
@@ -199,6 +216,7 @@ impl Film {
         let (lo, hi) = self.settings.pixel_bounds;
         let enc = Encoder {
             buckets: None,
+            luminance: false,
             ..self.encoder()
         };
         SplatBuffer::new(lo, hi, self.filter.clone(), enc)

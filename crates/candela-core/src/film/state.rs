@@ -13,6 +13,8 @@
 //! path, light and bidirectional tracing and of PPM and photon mapping are
 //! independent, identically distributed estimates of the image, so
 //! s²(m)/n is the variance of the image mean and s²(v)/n that of a pixel.
+//! The photometric layers keep Σv_p and Σv_p² of each pixel's per-pass
+//! luminance and first-hit illuminance in the same way.
 
 use super::fixed::{add_into, quantise};
 use super::layout::{FilmLayout, MAIN_DIRECT, MAIN_W, MAIN_WRGB};
@@ -166,6 +168,13 @@ impl FilmState {
                             q[o + 3 + k] = quantise(v[k] * v[k], layout.bits(o + 3 + k));
                         }
                     }
+                    if layout.photometric {
+                        let o = layout.photometric_variance_offset();
+                        for (k, v) in photometric_pass_values(s, layout).iter().enumerate() {
+                            q[o + 2 * k] = quantise(*v, layout.bits(o + 2 * k));
+                            q[o + 2 * k + 1] = quantise(v * v, layout.bits(o + 2 * k + 1));
+                        }
+                    }
                     sat += add_into(d, &q);
                 }
                 sat
@@ -239,6 +248,17 @@ fn pass_value(s: &[f64], m: &[[f64; 3]; 3]) -> [f64; 3] {
         avg + s[MAIN_DIRECT + c]
     });
     [0, 1, 2].map(|r| (0..3).map(|c| m[r][c] * sensor[c]).sum())
+}
+
+/// The pass's own luminance [cd/m²] and first-hit illuminance [lx] of one pixel.
+fn photometric_pass_values(s: &[f64], layout: &FilmLayout) -> [f64; 2] {
+    use super::layout::photo;
+    let o = layout.photometric_offset();
+    let ratio = |a: f64, w: f64| if w != 0.0 { a / w } else { 0.0 };
+    [
+        ratio(s[o + photo::WY], s[MAIN_W]) + s[o + photo::DY],
+        ratio(s[o + photo::WEE], s[o + photo::WE]),
+    ]
 }
 
 /// Mean of [`pass_value`] over the block.

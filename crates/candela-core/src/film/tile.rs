@@ -11,7 +11,7 @@
 use super::filter::Filter;
 use super::layout::{self, Buckets, FilmLayout, SurfaceAov};
 use crate::math::{UVec2, Vec2};
-use crate::spectrum::{PixelSensor, SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{luminous, PixelSensor, SampledSpectrum, SampledWavelengths};
 
 /// Scales `rgb` so its largest component is at most `max_component`
 /// (pbrt-v4's `maxcomponentvalue`); returns the factor applied.
@@ -32,6 +32,8 @@ pub(crate) struct Encoder {
     pub sensor: PixelSensor,
     pub max_component_value: f32,
     pub buckets: Option<Buckets>,
+    /// Also record the luminance Y_v (photometric layers; never clamped).
+    pub luminance: bool,
 }
 
 impl Encoder {
@@ -158,6 +160,8 @@ impl FilmTile {
         let w = weight as f64;
         let nb = self.layout.n_buckets();
         let so = self.layout.spectral_offset();
+        let po = self.layout.photometric_offset();
+        let photometric = self.layout.photometric;
         let range = self.row_range(pixel);
         let row = &mut self.rows[range];
         for (c, v) in rgb.iter().enumerate() {
@@ -167,6 +171,30 @@ impl FilmTile {
         if nb > 0 {
             self.enc.add_spectral(l, lambda, w, &mut row[so..so + nb]);
         }
+        if photometric {
+            row[po + layout::photo::WY] += w * luminous(&l, lambda);
+        }
+    }
+
+    /// Adds the illuminance `e` [lx] at the first visible surface of one
+    /// camera ray with filter weight `weight` (`None`: the ray escaped and
+    /// adds its weight only). Ignored without photometric layers;
+    /// non-finite values are dropped and counted.
+    pub fn add_illuminance(&mut self, pixel: UVec2, e: Option<f64>, weight: f32) {
+        if !self.layout.photometric {
+            return;
+        }
+        let e = e.unwrap_or(0.0);
+        if !e.is_finite() || !weight.is_finite() {
+            self.dropped += 1;
+            return;
+        }
+        let w = weight as f64;
+        let po = self.layout.photometric_offset();
+        let range = self.row_range(pixel);
+        let row = &mut self.rows[range];
+        row[po + layout::photo::WE] += w;
+        row[po + layout::photo::WEE] += w * e;
     }
 
     /// Adds the first-hit values of one camera sample with weight `weight`.
@@ -195,8 +223,10 @@ impl FilmTile {
 pub struct SplatBuffer {
     pub(crate) lo: UVec2,
     pub(crate) hi: UVec2,
-    /// Channels per pixel: rgb, then the spectral buckets.
+    /// Channels per pixel: rgb, then the spectral buckets, then Y_v if recorded.
     pub(crate) stride: usize,
+    /// Offset of Y_v in a pixel (photometric films only).
+    pub(crate) luminance: Option<usize>,
     pub(crate) sums: Vec<f64>,
     filter: Filter,
     inv_filter_integral: f32,
@@ -206,12 +236,15 @@ pub struct SplatBuffer {
 
 impl SplatBuffer {
     pub(crate) fn new(lo: UVec2, hi: UVec2, filter: Filter, enc: Encoder) -> Self {
-        let stride = 3 + enc.buckets.map_or(0, |b| b.n);
+        let spectral = 3 + enc.buckets.map_or(0, |b| b.n);
+        let luminance = enc.luminance.then_some(spectral);
+        let stride = spectral + enc.luminance as usize;
         let n = ((hi.x - lo.x) * (hi.y - lo.y)) as usize;
         Self {
             lo,
             hi,
             stride,
+            luminance,
             sums: vec![0.0; n * stride],
             inv_filter_integral: 1.0 / filter.integral(),
             filter,
@@ -243,6 +276,7 @@ impl SplatBuffer {
             return;
         }
         let (rgb, _) = self.enc.rgb(l, lambda);
+        let y_v = self.luminance.map(|_| luminous(&l, lambda));
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let c = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
@@ -254,11 +288,27 @@ impl SplatBuffer {
                 for (k, v) in rgb.iter().enumerate() {
                     self.sums[i + k] += (w * *v) as f64;
                 }
-                if self.stride > 3 {
-                    let spectral = &mut self.sums[i + 3..i + self.stride];
-                    self.enc.add_spectral(l, lambda, w as f64, spectral);
-                }
+                self.add_extra(i, l, lambda, w as f64, y_v);
             }
+        }
+    }
+
+    /// Adds the spectral buckets and the luminance of one weighted value at pixel offset `i`.
+    #[inline]
+    fn add_extra(
+        &mut self,
+        i: usize,
+        l: SampledSpectrum,
+        lambda: &SampledWavelengths,
+        w: f64,
+        y_v: Option<f64>,
+    ) {
+        if self.enc.buckets.is_some() {
+            let spectral = &mut self.sums[i + 3..i + self.stride];
+            self.enc.add_spectral(l, lambda, w, spectral);
+        }
+        if let (Some(o), Some(y)) = (self.luminance, y_v) {
+            self.sums[i + o] += w * y;
         }
     }
 
@@ -281,10 +331,8 @@ impl SplatBuffer {
         for (k, v) in rgb.iter().enumerate() {
             self.sums[i + k] += *v as f64;
         }
-        if self.stride > 3 {
-            let spectral = &mut self.sums[i + 3..i + self.stride];
-            self.enc.add_spectral(l, lambda, 1.0, spectral);
-        }
+        let y_v = self.luminance.map(|_| luminous(&l, lambda));
+        self.add_extra(i, l, lambda, 1.0, y_v);
     }
 }
 

@@ -1,10 +1,13 @@
 //! Images: RGB float images (the film's EXR and PNG output and the
 //! comparison metrics of `candela diff`, validation.md "Image metrics"), and
-//! map images read for textures and environment lights ([`MapImage`]).
+//! map images read for textures and environment lights ([`MapImage`]), and
+//! false-colour pictures of photometric layers ([`falsecolor`]).
 
 pub mod atomic;
 mod compare;
 pub mod exr_write;
+pub mod falsecolor;
+pub mod font;
 mod map;
 mod pyramid;
 mod read;

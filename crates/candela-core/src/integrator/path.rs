@@ -91,28 +91,75 @@ struct PathState {
     prev_ctx: LightSampleContext,
     /// Product of η² over refractions, to undo radiance scaling in roulette.
     eta_scale: f32,
+    /// The first ray was not BSDF-sampled (a camera ray): emission at the
+    /// first hit takes no MIS weight.
+    unweighted_start: bool,
 }
 
 impl PixelEstimator for PathIntegrator {
     fn li(
         &self,
         ctx: &RenderContext<'_>,
-        mut ray: Ray,
+        ray: Ray,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         _splats: &mut SplatBuffer,
     ) -> SampledSpectrum {
-        let scene = ctx.scene;
-        let mut st = PathState {
+        self.trace(ctx, ray, PathState::start(ray.o, None), lambda, sampler)
+    }
+}
+
+impl PathState {
+    /// The state before the first vertex of a path leaving `o`, along a
+    /// direction of solid-angle density `pdf` (`None`: a camera ray).
+    fn start(o: Vec3, pdf: Option<f32>) -> Self {
+        Self {
             l: SampledSpectrum::zero(),
             beta: SampledSpectrum::one(),
             depth: 0,
             specular_bounce: false,
             any_non_specular: false,
-            prev_pdf: 0.0,
-            prev_ctx: LightSampleContext::at_point(ray.o),
+            prev_pdf: pdf.unwrap_or(0.0),
+            prev_ctx: LightSampleContext::at_point(o),
             eta_scale: 1.0,
-        };
+            unweighted_start: pdf.is_none(),
+        }
+    }
+}
+
+impl PathIntegrator {
+    /// The radiance arriving at a sensor point `ray.o` along `ray`, whose
+    /// direction was sampled with solid-angle density `pdf` (`candela
+    /// measure`): as [`PixelEstimator::li`], but emission found at the
+    /// first hit is MIS-weighted (power heuristic) against a light sample
+    /// taken at the sensor from `LightSampleContext::at_point(ray.o)`.
+    pub(crate) fn li_sampled(
+        &self,
+        ctx: &RenderContext<'_>,
+        ray: Ray,
+        pdf: f32,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
+        self.trace(
+            ctx,
+            ray,
+            PathState::start(ray.o, Some(pdf)),
+            lambda,
+            sampler,
+        )
+    }
+
+    /// The path loop from state `st`.
+    fn trace(
+        &self,
+        ctx: &RenderContext<'_>,
+        mut ray: Ray,
+        mut st: PathState,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
+        let scene = ctx.scene;
         loop {
             let Some(mut si) = scene.intersect(&ray, f32::INFINITY) else {
                 self.add_infinite_light(scene, &ray, lambda, &mut st);
@@ -156,9 +203,7 @@ impl PixelEstimator for PathIntegrator {
         }
         st.l
     }
-}
 
-impl PathIntegrator {
     /// Radiance from infinite lights seen along an escaping ray, MIS-weighted.
     fn add_infinite_light(
         &self,
@@ -173,7 +218,7 @@ impl PathIntegrator {
             if le.is_black() {
                 continue;
             }
-            if st.depth == 0 || st.specular_bounce {
+            if (st.depth == 0 && st.unweighted_start) || st.specular_bounce {
                 st.l += st.beta * le;
             } else {
                 let p_light =
@@ -197,7 +242,7 @@ impl PathIntegrator {
         if le.is_black() {
             return;
         }
-        if st.depth == 0 || st.specular_bounce {
+        if (st.depth == 0 && st.unweighted_start) || st.specular_bounce {
             st.l += st.beta * le;
         } else {
             let p_light = scene.light_sampler().pmf(id) * light.pdf_li(&st.prev_ctx, -si.wo).0;

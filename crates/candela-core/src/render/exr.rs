@@ -39,6 +39,18 @@ pub fn exr_attributes(dev: &Developed, integrator: &str, total_passes: u64) -> E
         "candela.integrator".into(),
         ExrAttribute::Text(integrator.to_string()),
     );
+    if !dev.units.is_empty() {
+        a.insert(
+            "candela.units".into(),
+            ExrAttribute::Text("photometric".into()),
+        );
+    }
+    for (layer, unit) in &dev.units {
+        a.insert(
+            format!("{layer}.units"),
+            ExrAttribute::Text(unit.to_string()),
+        );
+    }
     a
 }
 

@@ -6,7 +6,7 @@
 //! for pass in passes not yet in the state {
 //!     stop requested, time or error budget spent?  → stop
 //!     integrator.render_pass(ctx, pass, &mut integrator_state, &mut block)
-//!     surface::render_surface_pass(ctx, pass, &mut block)   (first-hit layers, if any)
+//!     surface::render_surface_pass(ctx, pass, &mut block)   (first-hit layers and illuminance, if any)
 //!     film_state.add_pass(pass, block)            (exact, fixed point)
 //!     on_pass(state)                              (live view, …)
 //!     checkpoint if due
@@ -306,7 +306,7 @@ fn run_passes(
         if outcome == PassOutcome::Cancelled {
             return Ok((StopReason::Interrupted, rendered));
         }
-        if !setup.film.layout().surface.is_empty()
+        if setup.film.layout().needs_first_hit()
             && surface::render_surface_pass(ctx, pass, &mut block) == PassOutcome::Cancelled
         {
             return Ok((StopReason::Interrupted, rendered));

@@ -1,6 +1,6 @@
 //! The settings text stored in a [`super::RenderState`]: the overrides that
 //! decide a render's passes (`--spp`, `--integrator`, `--seed`,
-//! `--cropwindow`, `--aov`) as `key=value` lines, so that whoever merges or resumes
+//! `--cropwindow`, `--aov`, `--units`) as `key=value` lines, so that whoever merges or resumes
 //! the state rebuilds the same render. The format is the command line's
 //! (`candela render` writes it, `candela merge` reads it): a state made by
 //! the library, the Python module or a cluster merges with the CLI's.
@@ -27,6 +27,9 @@ pub fn settings_text(ov: &Overrides) -> String {
     if !ov.aovs.is_empty() {
         s.push_str(&format!("aov={}\n", Aov::list_text(&ov.aovs)));
     }
+    if ov.photometric {
+        s.push_str("units=photometric\n");
+    }
     s
 }
 
@@ -44,6 +47,7 @@ pub fn overrides_from_settings(text: &str) -> Result<Overrides, String> {
             "seed" => ov.seed = Some(v.parse().map_err(|e| bad(&e))?),
             "cropwindow" => ov.cropwindow = Some(parse_cropwindow(v).map_err(|e| bad(&e))?),
             "aov" => ov.aovs = Aov::parse_list(v).map_err(|e| bad(&e))?,
+            "units" if v == "photometric" => ov.photometric = true,
             _ => return Err(format!("unknown setting {k:?}")),
         }
     }
@@ -77,11 +81,12 @@ mod tests {
             outfile: Some("ignored.exr".into()),
             aovs: vec![Aov::Surface(crate::film::SurfaceAov::Albedo), Aov::Variance],
             memory_limit: Some(1 << 30),
+            photometric: true,
         };
         let text = settings_text(&ov);
         assert_eq!(
             text,
-            "spp=12\nintegrator=ppm\nseed=7\ncropwindow=0.25,0.5,0.0,1.0\naov=albedo,variance\n"
+            "spp=12\nintegrator=ppm\nseed=7\ncropwindow=0.25,0.5,0.0,1.0\naov=albedo,variance\nunits=photometric\n"
         );
         let back = overrides_from_settings(&text).expect("round trip");
         assert_eq!(settings_text(&back), text);
@@ -91,7 +96,13 @@ mod tests {
             "the memory limit is not a render's identity"
         );
         assert_eq!(settings_text(&Overrides::default()), "");
-        for bad in ["spp", "spp=x\n", "colour=red\n", "cropwindow=0.5,0.2,0,1\n"] {
+        for bad in [
+            "spp",
+            "spp=x\n",
+            "colour=red\n",
+            "cropwindow=0.5,0.2,0,1\n",
+            "units=sensor\n",
+        ] {
             assert!(overrides_from_settings(bad).is_err(), "{bad:?}");
         }
     }

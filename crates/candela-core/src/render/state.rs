@@ -305,7 +305,9 @@ fn write_film(out: &mut Vec<u8>, f: &FilmState) {
     for a in &l.surface {
         put_u64(out, AOVS.iter().position(|x| x == a).unwrap_or(0) as u64);
     }
-    put_u64(out, l.variance as u64);
+    // Bit 0: the variance layer; bit 1: the photometric layers (files
+    // written before the photometric layers existed hold 0 or 1).
+    put_u64(out, l.variance as u64 | (l.photometric as u64) << 1);
     put_u64(out, l.strategies as u64);
     put_u64(out, f.pixels as u64);
     put_u64(out, f.passes.ranges().len() as u64);
@@ -353,13 +355,17 @@ fn read_film(r: &mut Reader<'_>) -> Result<FilmState, Short> {
     let surface = (0..ns)
         .map(|_| AOVS.get(r.len(AOVS.len() as u64)?).copied().ok_or(Short))
         .collect::<Result<Vec<_>, _>>()?;
-    let variance = r.u64()? != 0;
+    let flags = r.u64()?;
+    if flags > 3 {
+        return Err(Short);
+    }
     let strategies = r.len(1 << 16)?;
     let layout = FilmLayout {
         spectral,
         surface,
-        variance,
+        variance: flags & 1 != 0,
         strategies,
+        photometric: flags & 2 != 0,
     };
     let pixels = r.len(1 << 40)?;
     let n_ranges = r.len(1 << 32)?;

@@ -27,14 +27,29 @@
 //!   meeting the hit's tangent plane (pbrt-v4's ray differentials; pbrt-v4
 //!   further scales them by max(1/8, 1/√spp), candela does not: the values
 //!   are per pixel).
+//!
+//! **Illuminance** (photometric films, `--units photometric`): at the same
+//! first surface, one sample per pass of E_v [lx] arriving from the side
+//! the camera sees (the geometric normal turned towards the ray), by the
+//! very estimator of `candela measure` ([`crate::measure`]: delta lights
+//! by shadow rays plus a cosine-weighted path-traced direction, at the
+//! camera sample's wavelengths, drawing its other dimensions after the
+//! camera sample's). Each pass's value is an independent unbiased estimate
+//! of E_v at the pixel's visible surface (Radiance's `rpict -i`), so the
+//! per-pass spread gives its standard error; a ray that escapes adds its
+//! weight and E_v = 0. Its paths follow at most
+//! [`crate::film::Film::illuminance_depth`] scattering events: one fewer
+//! than the camera paths, whose first is at that surface, so a Lambertian
+//! surface of albedo ρ has luminance ρE_v/π in the same render.
 
-use crate::bsdf::TransportMode;
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::camera::CameraSample;
 use crate::film::{PassBlock, SurfaceSample, SurfaceSpace};
 use crate::integrator::driver::for_each_tile;
-use crate::integrator::{PassOutcome, RenderContext};
+use crate::integrator::{PassOutcome, PathIntegrator, RenderContext};
 use crate::interaction::SurfaceInteraction;
 use crate::math::{face_forward, Ray, Transform, UVec2, Vec2, Vec3};
+use crate::measure;
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
 
@@ -60,16 +75,22 @@ pub fn render_surface_pass(
     block: &mut PassBlock,
 ) -> PassOutcome {
     let camera_from_world = ctx.camera.world_from_camera().inverse();
+    let meter = measure::meter_path(ctx.film.illuminance_depth());
     let tiles = for_each_tile(ctx, |lo, hi| {
         let mut tile = ctx.film.tile(lo, hi);
         let mut sampler = ctx.sampler.clone();
+        let mut cx = PixelContext {
+            ctx,
+            camera_from_world: &camera_from_world,
+            meter: &meter,
+            sampler: &mut sampler,
+        };
         for y in lo.y..hi.y {
             for x in lo.x..hi.x {
                 let pixel = UVec2::new(x, y);
-                if let Some((s, w)) =
-                    pixel_sample(ctx, &camera_from_world, pixel, pass, &mut sampler)
-                {
+                if let Some((s, e, w)) = cx.pixel_sample(pixel, pass) {
                     tile.add_surface(pixel, &s, w);
+                    tile.add_illuminance(pixel, e, w);
                 }
             }
         }
@@ -84,37 +105,60 @@ pub fn render_surface_pass(
     PassOutcome::Done
 }
 
-/// The first-hit values of sample `pass` of `pixel` and its filter weight
-/// (`None` when the camera makes no ray there).
-fn pixel_sample(
-    ctx: &RenderContext<'_>,
-    camera_from_world: &Transform,
-    pixel: UVec2,
-    pass: u64,
-    sampler: &mut Sampler,
-) -> Option<(SurfaceSample, f32)> {
-    sampler.start_pixel_sample(pixel, pass as u32, 0);
-    // The draws of `integrator::driver::camera_sample`, in its order.
-    let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
-    let fs = ctx.film.filter().sample(sampler.get_pixel_2d());
-    let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
-    let time = ctx.scene.sample_time(|| sampler.get_1d());
-    let p_lens = sampler.get_2d();
-    let cr = ctx.camera.generate_ray(CameraSample { p_film, p_lens })?;
-    let ray = cr.ray.at_time(time);
-    let s = first_hit(ctx, camera_from_world, &ray, lambda, p_film, p_lens).unwrap_or_default();
-    Some((s, fs.weight))
+/// What the first-hit pass needs at every pixel of a tile.
+struct PixelContext<'a, 'c> {
+    ctx: &'a RenderContext<'c>,
+    camera_from_world: &'a Transform,
+    meter: &'a PathIntegrator,
+    sampler: &'a mut Sampler,
 }
 
-/// Follows `ray` through interfaces to the first surface with a BSDF and records it.
-fn first_hit(
+impl PixelContext<'_, '_> {
+    /// The first-hit values of sample `pass` of `pixel`, the illuminance
+    /// at its first surface (photometric films; `None` when the ray
+    /// escapes) and its filter weight (`None` when the camera makes no ray
+    /// there).
+    fn pixel_sample(
+        &mut self,
+        pixel: UVec2,
+        pass: u64,
+    ) -> Option<(SurfaceSample, Option<f64>, f32)> {
+        let (ctx, sampler) = (self.ctx, &mut *self.sampler);
+        sampler.start_pixel_sample(pixel, pass as u32, 0);
+        // The draws of `integrator::driver::camera_sample`, in its order.
+        let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
+        let fs = ctx.film.filter().sample(sampler.get_pixel_2d());
+        let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
+        let time = ctx.scene.sample_time(|| sampler.get_1d());
+        let p_lens = sampler.get_2d();
+        let cr = ctx.camera.generate_ray(CameraSample { p_film, p_lens })?;
+        let ray = cr.ray.at_time(time);
+        let layout = ctx.film.layout();
+        let Some((si, bsdf, lam)) = first_surface(ctx, &ray, lambda) else {
+            return Some((SurfaceSample::default(), None, fs.weight));
+        };
+        let s = if layout.surface.is_empty() {
+            SurfaceSample::default()
+        } else {
+            let dz = depth_gradient(ctx, self.camera_from_world, &si, p_film, p_lens, ray.time);
+            record(ctx, self.camera_from_world, &si, &bsdf, &lam, &ray, dz)
+        };
+        let e = layout.photometric.then(|| {
+            let n = face_forward(si.n(), si.wo).normalize_or_zero();
+            let origin = measure::sensor_origin(ctx.scene, si.p(), n);
+            measure::illuminance_sample(ctx, self.meter, origin, n, lambda, sampler)
+        });
+        Some((s, e, fs.weight))
+    }
+}
+
+/// Follows `ray` through interfaces to the first surface with a BSDF: the
+/// hit, its BSDF and the wavelengths after it (dispersion may end some).
+fn first_surface(
     ctx: &RenderContext<'_>,
-    camera_from_world: &Transform,
     ray: &Ray,
     lambda: SampledWavelengths,
-    p_film: Vec2,
-    p_lens: Vec2,
-) -> Option<SurfaceSample> {
+) -> Option<(SurfaceInteraction, Bsdf, SampledWavelengths)> {
     let mut r = *ray;
     for _ in 0..MAX_INTERFACES {
         let mut si = ctx.scene.intersect(&r, f32::INFINITY)?;
@@ -123,29 +167,41 @@ fn first_hit(
             r = si.spawn_ray(r.d);
             continue;
         };
-        let (uc, u) = rho_samples();
-        let rho = bsdf.rho(si.wo, &uc, &u, TransportMode::Radiance);
-        let cs = ctx.film.color_space();
-        let xyz = (rho * cs.illuminant.sample(&lam)).to_xyz(&lam);
-        let rgb = cs.rgb_from_xyz * Vec3::new(xyz.x, xyz.y, xyz.z);
-        let to_out = match ctx.film.surface_space() {
-            SurfaceSpace::World => Transform::IDENTITY,
-            SurfaceSpace::Camera => *camera_from_world,
-        };
-        let wo = to_out.vector(si.wo);
-        let facing = |n: Vec3| face_forward(to_out.normal(n).normalize_or_zero(), wo).to_array();
-        let dz = depth_gradient(ctx, camera_from_world, &si, p_film, p_lens, r.time);
-        return Some(SurfaceSample {
-            albedo: rgb.to_array(),
-            p: to_out.point(si.p()).to_array(),
-            n: facing(si.n()),
-            ns: facing(si.shading.n),
-            depth: (si.p() - ray.o).length(),
-            uv: [si.it.uv.x, si.it.uv.y],
-            dz,
-        });
+        return Some((si, bsdf, lam));
     }
     None
+}
+
+/// The first-hit values of the surface `si` with BSDF `bsdf`, met by `ray`.
+fn record(
+    ctx: &RenderContext<'_>,
+    camera_from_world: &Transform,
+    si: &SurfaceInteraction,
+    bsdf: &Bsdf,
+    lam: &SampledWavelengths,
+    ray: &Ray,
+    dz: [f32; 2],
+) -> SurfaceSample {
+    let (uc, u) = rho_samples();
+    let rho = bsdf.rho(si.wo, &uc, &u, TransportMode::Radiance);
+    let cs = ctx.film.color_space();
+    let xyz = (rho * cs.illuminant.sample(lam)).to_xyz(lam);
+    let rgb = cs.rgb_from_xyz * Vec3::new(xyz.x, xyz.y, xyz.z);
+    let to_out = match ctx.film.surface_space() {
+        SurfaceSpace::World => Transform::IDENTITY,
+        SurfaceSpace::Camera => *camera_from_world,
+    };
+    let wo = to_out.vector(si.wo);
+    let facing = |n: Vec3| face_forward(to_out.normal(n).normalize_or_zero(), wo).to_array();
+    SurfaceSample {
+        albedo: rgb.to_array(),
+        p: to_out.point(si.p()).to_array(),
+        n: facing(si.n()),
+        ns: facing(si.shading.n),
+        depth: (si.p() - ray.o).length(),
+        uv: [si.it.uv.x, si.it.uv.y],
+        dz,
+    }
 }
 
 /// |∂z/∂x|, |∂z/∂y| of camera-space z at the hit: where the rays one pixel

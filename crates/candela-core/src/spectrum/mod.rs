@@ -52,6 +52,20 @@ pub fn cie_xyz(lambda: f32) -> [f32; 3] {
     ]
 }
 
+/// The photometric value of a spectral estimate at sampled wavelengths:
+/// K_m·(1/N) Σ_k ȳ(λ_k)·e_k/p(λ_k), with V(λ) = ȳ(λ) un-normalised (ȳ(555) = 1,
+/// *not* divided by ∫ȳ as pbrt-v4's sensor Y is). Radiance in W/(m²·sr·nm)
+/// gives cd/m², irradiance lx; terminated wavelengths (pdf 0) count 0.
+pub fn luminous(e: &SampledSpectrum, lambda: &SampledWavelengths) -> f64 {
+    let pdf = lambda.pdf();
+    let n = lambda.lambdas().len();
+    let y: f64 = (0..n)
+        .filter(|&k| pdf[k] > 0.0)
+        .map(|k| cie_xyz(lambda.lambda(k))[1] as f64 * e[k] as f64 / pdf[k] as f64)
+        .sum();
+    K_M as f64 * y / n as f64
+}
+
 #[cfg(test)]
 mod sensor_tests;
 #[cfg(test)]

@@ -12,6 +12,7 @@ pub fn dir(kind: &str, name: &str) -> PathBuf {
 
 /// Writes `scene` and `points` into `d`, runs `candela measure` with `args`
 /// and returns (E, stderr) per point, checking the CSV header.
+#[allow(dead_code)] // not every test crate measures
 pub fn measure(d: &Path, scene: &str, points: &str, args: &[&str]) -> Vec<(f64, f64)> {
     std::fs::write(d.join("s.pbrt"), scene).unwrap();
     std::fs::write(d.join("p.txt"), points).unwrap();
@@ -38,4 +39,30 @@ pub fn measure(d: &Path, scene: &str, points: &str, args: &[&str]) -> Vec<(f64, 
             (v[6], v[7])
         })
         .collect()
+}
+
+/// T5's room (validation.md): `WorldBegin` and a closed cube [−2, 2]³ of
+/// diffuse albedo `rho` around a 10 000 lm isotropic point light at its
+/// centre (area-mean illuminance Φ/(S(1 − ρ)), S = 96 m²).
+#[allow(dead_code)] // not every test crate builds rooms
+pub fn t5_cube_world(rho: f64) -> String {
+    let mut p = String::new();
+    for i in 0..8 {
+        let c = |b: i32| if i >> b & 1 == 1 { 2 } else { -2 };
+        p += &format!("{} {} {} ", c(0), c(1), c(2));
+    }
+    // Faces x−, x+, y−, y+, z−, z+ as two triangles each.
+    let idx = "0 2 6 0 6 4 1 5 7 1 7 3 0 4 5 0 5 1 2 3 7 2 7 6 0 1 3 0 3 2 4 6 7 4 7 5";
+    format!(
+        "WorldBegin\n\
+         LightSource \"point\" \"float lumens\" 10000 \"point3 from\" [0 0 0]\n\
+         Material \"diffuse\" \"spectrum reflectance\" [300 {rho} 800 {rho}]\n\
+         Shape \"trianglemesh\" \"point3 P\" [{p}] \"integer indices\" [{idx}]\n"
+    )
+}
+
+/// T5's area-mean illuminance Φ/(S(1 − ρ)) [lx] of [`t5_cube_world`].
+#[allow(dead_code)]
+pub fn t5(rho: f64) -> f64 {
+    10_000.0 / (96.0 * (1.0 - rho))
 }
