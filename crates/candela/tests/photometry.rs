@@ -46,10 +46,13 @@ fn inverse_square(i: f64) -> Vec<f64> {
 #[test]
 fn point_light_in_lumens_follows_the_inverse_square_law_for_any_spectrum() {
     let d = dir("point");
-    // T8: 1000 lm isotropic → 79.577 cd → 19.894 lx 2 m below, any spectrum.
+    // T8: 1000 lm isotropic → 79.577 cd → 19.894 lx 2 m below, any spectrum;
+    // an RGB colour too (pbrt-v4's normalisation by the RGB's illuminant
+    // alone would give Y(rgb) = 0.40 of it for this orange).
     for spectrum in [
         "\"blackbody I\" 2856",
         "\"spectrum I\" \"stdillum-D65\"",
+        "\"rgb I\" [0.9 0.3 0.1]",
         "",
     ] {
         let scene = format!(
@@ -75,8 +78,9 @@ fn ies_goniometric_light_gives_its_tabulated_candela() {
         "IESNA:LM-63-2002\n[TEST] linear\nTILT=NONE\n1 -1 1 3 1 1 1 0 0 0\n1 1 0\n0 90 180\n0\n100 150 0\n",
     )
     .unwrap();
+    // The file is in candela: an RGB `I` sets the colour only.
     let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
-                 LightSource \"goniometric\" \"string filename\" \"t.ies\" \"point3 from\" [0 0 2] \"point3 to\" [0 0 0]\n";
+                 LightSource \"goniometric\" \"string filename\" \"t.ies\" \"rgb I\" [0.3 0.6 0.9] \"point3 from\" [0 0 2] \"point3 to\" [0 0 0]\n";
     let got = measure(&d, scene, POINTS);
     for ((x, y), g) in [(0.0f64, 0.0f64), (1.0, 0.0), (0.0, 1.5)]
         .into_iter()
@@ -92,10 +96,14 @@ fn ies_goniometric_light_gives_its_tabulated_candela() {
 #[test]
 fn uniform_sky_in_luminance_gives_pi_l() {
     let d = dir("sky");
-    let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
-                 LightSource \"infinite\" \"float luminance\" 100\n";
-    for g in measure(&d, scene, POINTS) {
-        within_5_sigma(g, std::f64::consts::PI * 100.0);
+    for colour in ["", "\"rgb L\" [0.2 0.5 0.9]"] {
+        let scene = format!(
+            "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+             LightSource \"infinite\" \"float luminance\" 100 {colour}\n"
+        );
+        for g in measure(&d, &scene, POINTS) {
+            within_5_sigma(g, std::f64::consts::PI * 100.0);
+        }
     }
 }
 
@@ -107,18 +115,24 @@ fn a_small_luminaire_is_found_by_light_sampling() {
     // sampling alone would hit it in ~10 of 4000 samples (σ ≈ 30 %); the
     // 1 % bound on σ of `within_5_sigma` needs the light samples.
     let d = dir("disk");
-    let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
-                 AttributeBegin\nTranslate 0 0 2\n\
-                 AreaLightSource \"diffuse\" \"float luminance\" 1000 \"blackbody L\" 3000 \"bool twosided\" true\n\
-                 Shape \"disk\" \"float radius\" 0.1\nAttributeEnd\n";
     let (l, r, h) = (1000.0, 0.1, 2.0);
     let want = std::f64::consts::PI * l * r * r / (h * h + r * r);
-    let got = measure(&d, scene, "0 0 0 0 0 1\n");
-    eprintln!(
-        "disk: {:.4} ± {:.4} lx (expected {want:.4})",
-        got[0].0, got[0].1
-    );
-    within_5_sigma(got[0], want);
+    // A blackbody, and an RGB colour (whose luminance must not scale the
+    // requested cd/m² by Y(rgb) = 0.46, as pbrt-v4's normalisation would).
+    for colour in ["\"blackbody L\" 3000", "\"rgb L\" [0.2 0.5 0.9]"] {
+        let scene = format!(
+            "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+             AttributeBegin\nTranslate 0 0 2\n\
+             AreaLightSource \"diffuse\" \"float luminance\" 1000 {colour} \"bool twosided\" true\n\
+             Shape \"disk\" \"float radius\" 0.1\nAttributeEnd\n"
+        );
+        let got = measure(&d, &scene, "0 0 0 0 0 1\n");
+        eprintln!(
+            "disk {colour}: {:.4} ± {:.4} lx (expected {want:.4})",
+            got[0].0, got[0].1
+        );
+        within_5_sigma(got[0], want);
+    }
 }
 
 #[test]

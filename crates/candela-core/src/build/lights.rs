@@ -149,6 +149,10 @@ pub fn area_light_spec(
     let what = format!("AreaLightSource \"{}\"", a.name);
     let ck = Check::new(p, &a.loc, &what);
     let u = units(&ck, UnitsOf::Area)?;
+    let u = match &emission {
+        AreaEmission::Spectrum(s) => u.colour_only(s),
+        AreaEmission::Image(..) => u,
+    };
     Ok(AreaLightSpec {
         emission,
         scene_cs,
@@ -192,19 +196,21 @@ fn light(d: &LightDesc, warnings: &mut Vec<String>) -> Result<Light, BuildError>
     let u = |of| units(&ck, of);
     Ok(match d.name.as_str() {
         "point" => {
-            let u = u(UnitsOf::Intensity)?;
-            Light::Point(create::point_light(&t, illum("I")?, u.scale, u.target, from))
+            let i = illum("I")?;
+            let u = u(UnitsOf::Intensity)?.colour_only(&i);
+            Light::Point(create::point_light(&t, i, u.scale, u.target, from))
         }
         "spot" => {
-            let u = u(UnitsOf::Intensity)?;
+            let i = illum("I")?;
+            let u = u(UnitsOf::Intensity)?.colour_only(&i);
             let cone = ck.float("coneangle", 30.0, Domain::LeftOpen(0.0, 180.0))?;
             let delta = ck.float("conedeltaangle", 5.0, Domain::Closed(0.0, cone))?;
-            let i = illum("I")?;
             Light::Spot(create::spot_light(&t, i, u.scale, cone, delta, u.target, from, to))
         }
         "distant" => {
-            let u = u(UnitsOf::Distant)?;
-            Light::Distant(create::distant_light(&t, illum("L")?, u.scale, u.target, from, to))
+            let l = illum("L")?;
+            let u = u(UnitsOf::Distant)?.colour_only(&l);
+            Light::Distant(create::distant_light(&t, l, u.scale, u.target, from, to))
         }
         "infinite" => infinite(d, &ck, &t, space, warnings)?,
         "goniometric" if is_ies(p)? => ies(d, &ck, &t, illum("I")?, (from, to), warnings)?,
@@ -232,6 +238,7 @@ fn infinite(
     let Units {
         scale,
         target: illuminance,
+        photometric,
         ..
     } = units(ck, of)?;
     if p.get_point3s("portal")?.is_some() {
@@ -242,10 +249,15 @@ fn infinite(
     }
     let Some(path) = file else {
         let l = l.unwrap_or_else(|| space.illuminant.clone());
-        return Ok(Light::UniformInfinite(create::uniform_infinite_light(
-            l,
+        let u = Units {
             scale,
-            illuminance,
+            target: illuminance,
+            from_lumens: false,
+            photometric,
+        }
+        .colour_only(&l);
+        return Ok(Light::UniformInfinite(create::uniform_infinite_light(
+            l, u.scale, u.target,
         )));
     };
     if l.is_some() {
@@ -368,7 +380,13 @@ fn ies(
     (from, to): (Vec3, Vec3),
     warnings: &mut Vec<String>,
 ) -> Result<Light, BuildError> {
-    let u = units(ck, UnitsOf::IesWeb)?;
+    // The file is in candela: `I` sets only the colour, photometric
+    // parameter or not.
+    let u = Units {
+        photometric: true,
+        ..units(ck, UnitsOf::IesWeb)?
+    }
+    .colour_only(&i);
     let path = d.params.get_filename("filename")?.unwrap_or_default();
     let loc = ck.loc_of("filename");
     if !path.is_file() {

@@ -7,7 +7,12 @@
 //! see `light::create`), so after that normalisation `scale = 1` means
 //! K_m = 683 cd (or cd/m², lx) and pbrt-v4's `power` Φ means Φ·K_m lumens.
 //! A photometric parameter is therefore its value ÷ K_m in pbrt-v4's units,
-//! and the spectrum (`I`, `L`) only sets the colour:
+//! and the spectrum (`I`, `L`) only sets the colour. pbrt-v4 normalises an
+//! RGB spectrum by its illuminant alone, which leaves the RGB's relative
+//! luminance Y in the emission; with a photometric parameter (and always for
+//! an IES file, which is in candela) [`Units::colour_only`] divides it out,
+//! so `"rgb L" [0.2 0.5 0.9] "float luminance" 250` emits 250 cd/m², not
+//! 250·Y. pbrt-v4's own `power`/`illuminance`/`scale` keep its meaning:
 //!
 //! | parameter | lights | meaning |
 //! |---|---|---|
@@ -28,7 +33,7 @@
 
 use super::check::{Check, Domain};
 use super::BuildError;
-use crate::spectrum::K_M;
+use crate::spectrum::{cie_xyz, inner_product, spectrum_to_photometric, Spectrum, K_M};
 
 /// The photometric parameter names.
 const NAMES: [&str; 4] = ["candela", "luminance", "lumens", "lux"];
@@ -79,6 +84,36 @@ pub struct Units {
     pub target: Option<f32>,
     /// True when `target` came from `lumens` (an area light then shares it).
     pub from_lumens: bool,
+    /// True when a photometric parameter was given (see [`Units::colour_only`]).
+    pub photometric: bool,
+}
+
+impl Units {
+    /// The units for a light of spectrum `s` when its photometric value must
+    /// hold exactly, the spectrum setting only the colour. pbrt-v4's
+    /// normalisation divides by the photometric value of an RGB spectrum's
+    /// illuminant alone, so an `"rgb L"` of luminance Y (relative to the
+    /// illuminant) would emit Y times the requested cd/m²; this divides that
+    /// Y out. Other spectra are already exact (factor 1), and without a
+    /// photometric parameter pbrt-v4's meaning stays.
+    pub fn colour_only(self, s: &Spectrum) -> Units {
+        if !self.photometric {
+            return self;
+        }
+        let (full, norm) = (
+            inner_product(|l| cie_xyz(l)[1], |l| s.eval(l)),
+            spectrum_to_photometric(s),
+        );
+        if !(full > 0.0 && norm > 0.0) {
+            return self;
+        }
+        let y = full / norm;
+        Units {
+            scale: self.scale / y,
+            target: self.target,
+            ..self
+        }
+    }
 }
 
 /// Reads `scale`, pbrt-v4's target and the photometric parameters of a light.
@@ -105,6 +140,7 @@ pub fn units(ck: &Check<'_>, of: UnitsOf) -> Result<Units, BuildError> {
             scale,
             target: pbrt,
             from_lumens: false,
+            photometric: false,
         });
     };
     if pbrt.is_some() {
@@ -116,21 +152,25 @@ pub fn units(ck: &Check<'_>, of: UnitsOf) -> Result<Units, BuildError> {
             scale,
             target: Some(k),
             from_lumens: true,
+            photometric: true,
         },
         ("lux", UnitsOf::UniformSky) => Units {
             scale,
             target: Some(k),
             from_lumens: false,
+            photometric: true,
         },
         ("lux", UnitsOf::ImageSky) => Units {
             scale,
             target: Some(k / 2.0),
             from_lumens: false,
+            photometric: true,
         },
         _ => Units {
             scale: scale * k,
             target: None,
             from_lumens: false,
+            photometric: true,
         },
     })
 }
