@@ -2,8 +2,10 @@
 //!
 //! At a point x with unit normal n the illuminance is
 //! E_v = K_m ∫ V(λ) ∫_{H²(n)} L(x, ω, λ) cos θ dω dλ [CIE S 017/E:2011,
-//! 17-21-060]. One sample estimates it with two parts that cannot find the
-//! same light path, so their sum is unbiased without MIS:
+//! 17-21-060]. One sample estimates it with three parts: the first finds
+//! light paths the others cannot, and the last two, which can find the same
+//! emission, share it by multiple importance sampling, so the sum is
+//! unbiased:
 //!
 //! - **delta lights** (point, spot, goniometric, projection, distant),
 //!   which no ray can hit: each one's I·cos θ/d² (or E·cos θ) with a
