@@ -100,29 +100,15 @@ fn uneven_pass_ranges_merge_into_the_bytes_of_one_run_for_every_integrator() {
                 &d.join(format!("p{a}.exr")),
             );
         }
-        let o = candela()
-            .arg("merge")
-            .arg(&s)
-            .args(
-                [
-                    "p5.passes-5-7.cndl",
-                    "p0.passes-0-1.cndl",
-                    "p1.passes-1-5.cndl",
-                ]
-                .map(|p| d.join(p)),
-            )
-            .arg("-o")
-            .arg(d.join("merged.exr"))
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        assert!(
-            bytes(&d.join("merged.exr")) == bytes(&d.join("full.exr")),
-            "{name}: merged EXR differs from one run"
+        merge_equals_full(
+            &d,
+            &s,
+            name,
+            &[
+                "p5.passes-5-7.cndl",
+                "p0.passes-0-1.cndl",
+                "p1.passes-1-5.cndl",
+            ],
         );
         assert!(
             bytes(&d.join("merged.png")) == bytes(&d.join("full.png")),
@@ -200,7 +186,7 @@ fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
             f.extend(["--pass-range", &r]);
             run(&s, &f, &d.join(format!("p{a}.exr")));
         }
-        merge_equals_full(&d, &s, name);
+        merge_equals_full(&d, &s, name, &["p2.passes-2-5.cndl", "p0.passes-0-2.cndl"]);
         let layers = candela_core::image::read_exr_layers(&d.join("full.exr")).unwrap();
         assert!(layers.layers.len() > 1, "{name}: no layers written");
         if extra.contains(&"photometric") {
@@ -217,13 +203,12 @@ fn pass_ranges_with_layers_merge_into_the_bytes_of_one_run() {
     }
 }
 
-/// Merges the parts p0 (passes 0..2) and p2 (2..5) in `d` and checks the
-/// EXR equals `full.exr`.
-fn merge_equals_full(d: &Path, s: &Path, name: &str) {
+/// Merges the `parts` in `d` and checks the EXR equals `full.exr`.
+fn merge_equals_full(d: &Path, s: &Path, name: &str, parts: &[&str]) {
     let o = candela()
         .arg("merge")
         .arg(s)
-        .args(["p2.passes-2-5.cndl", "p0.passes-0-2.cndl"].map(|p| d.join(p)))
+        .args(parts.iter().map(|p| d.join(p)))
         .arg("-o")
         .arg(d.join("merged.exr"))
         .output()
