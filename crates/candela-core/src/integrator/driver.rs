@@ -136,6 +136,8 @@ pub(crate) struct PixelSample {
     pub lambda: SampledWavelengths,
     /// Filter-sample weight.
     pub filter_weight: f32,
+    /// The film and lens points the ray was generated from.
+    pub camera_sample: CameraSample,
 }
 
 /// Draws wavelengths, a filter offset and a lens point for `pixel`, in
@@ -150,11 +152,13 @@ pub(crate) fn camera_sample(
     let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
     let time = ctx.scene.sample_time(|| sampler.get_1d());
     let p_lens = sampler.get_2d();
-    let cr = ctx.camera.generate_ray(CameraSample { p_film, p_lens })?;
+    let camera_sample = CameraSample { p_film, p_lens };
+    let cr = ctx.camera.generate_ray(camera_sample)?;
     Some(PixelSample {
         ray: cr.ray.at_time(time),
         ray_weight: cr.weight,
         lambda,
         filter_weight: fs.weight,
+        camera_sample,
     })
 }

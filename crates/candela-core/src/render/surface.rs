@@ -45,7 +45,7 @@
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::camera::CameraSample;
 use crate::film::{PassBlock, SurfaceSample, SurfaceSpace};
-use crate::integrator::driver::for_each_tile;
+use crate::integrator::driver::{camera_sample, for_each_tile};
 use crate::integrator::{PassOutcome, PathIntegrator, RenderContext};
 use crate::interaction::SurfaceInteraction;
 use crate::math::{face_forward, Ray, Transform, UVec2, Vec2, Vec3};
@@ -125,17 +125,13 @@ impl PixelContext<'_, '_> {
     ) -> Option<(SurfaceSample, Option<f64>, f32)> {
         let (ctx, sampler) = (self.ctx, &mut *self.sampler);
         sampler.start_pixel_sample(pixel, pass as u32, 0);
-        // The draws of `integrator::driver::camera_sample`, in its order.
-        let lambda = SampledWavelengths::sample_visible(sampler.get_1d());
-        let fs = ctx.film.filter().sample(sampler.get_pixel_2d());
-        let p_film = pixel.as_vec2() + Vec2::splat(0.5) + fs.p;
-        let time = ctx.scene.sample_time(|| sampler.get_1d());
-        let p_lens = sampler.get_2d();
-        let cr = ctx.camera.generate_ray(CameraSample { p_film, p_lens })?;
-        let ray = cr.ray.at_time(time);
+        // The same draws as the integrators' camera samples.
+        let cs = camera_sample(ctx, pixel, sampler)?;
+        let (ray, lambda, fs_weight) = (cs.ray, cs.lambda, cs.filter_weight);
+        let CameraSample { p_film, p_lens } = cs.camera_sample;
         let layout = ctx.film.layout();
         let Some((si, bsdf, lam)) = first_surface(ctx, &ray, lambda) else {
-            return Some((SurfaceSample::default(), None, fs.weight));
+            return Some((SurfaceSample::default(), None, fs_weight));
         };
         let s = if layout.surface.is_empty() {
             SurfaceSample::default()
@@ -148,7 +144,7 @@ impl PixelContext<'_, '_> {
             let origin = measure::sensor_origin(ctx.scene, si.p(), n);
             measure::illuminance_sample(ctx, self.meter, origin, n, lambda, sampler)
         });
-        Some((s, e, fs.weight))
+        Some((s, e, fs_weight))
     }
 }
 
