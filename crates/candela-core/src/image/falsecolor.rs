@@ -20,7 +20,6 @@
 //! and every fifth of the range on a linear one, in the hand-made font of
 //! [`super::font`].
 
-use super::atomic::write_atomic_bytes;
 use super::font;
 use super::ImageError;
 use std::path::Path;
@@ -267,24 +266,7 @@ pub fn render(
 
 /// Writes [`render`]'s picture as a PNG at `path`, atomically.
 pub fn write_png(pic: &Picture, path: &Path) -> Result<(), ImageError> {
-    use image::ImageEncoder;
-    let name = || path.display().to_string();
-    let mut png = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut png)
-        .write_image(
-            &pic.rgb,
-            pic.width as u32,
-            pic.height as u32,
-            image::ExtendedColorType::Rgb8,
-        )
-        .map_err(|error| ImageError::Png {
-            path: name(),
-            error,
-        })?;
-    write_atomic_bytes(path, &png).map_err(|error| ImageError::Io {
-        path: name(),
-        error,
-    })
+    super::write_rgb8_png(path, &pic.rgb, pic.width, pic.height)
 }
 
 #[cfg(test)]

@@ -133,7 +133,6 @@ impl RgbImage {
     /// Writes an 8-bit sRGB PNG, atomically: linear values scaled by
     /// 2^`stops`, clipped to [0, 1] and encoded with the sRGB transfer curve.
     pub fn write_png(&self, path: &Path, stops: f32) -> Result<(), ImageError> {
-        use image::ImageEncoder;
         let scale = 2f32.powf(stops);
         let mut buf = Vec::with_capacity(self.width * self.height * 3);
         for p in &self.pixels {
@@ -141,23 +140,7 @@ impl RgbImage {
                 buf.push((srgb_encode(c * scale) * 255.0 + 0.5) as u8);
             }
         }
-        let name = || path.display().to_string();
-        let mut png = Vec::new();
-        image::codecs::png::PngEncoder::new(&mut png)
-            .write_image(
-                &buf,
-                self.width as u32,
-                self.height as u32,
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(|error| ImageError::Png {
-                path: name(),
-                error,
-            })?;
-        write_atomic_bytes(path, &png).map_err(|error| ImageError::Io {
-            path: name(),
-            error,
-        })
+        write_rgb8_png(path, &buf, self.width, self.height)
     }
 
     /// The pixels x0 ≤ x < x1, y0 ≤ y < y1 of `r = [x0, y0, x1, y1]`; `None` if outside.
@@ -200,6 +183,34 @@ pub fn srgb_encode(v: f32) -> f32 {
     } else {
         1.055 * v.powf(1.0 / 2.4) - 0.055
     }
+}
+
+/// Writes 8-bit sRGB triples (`width × height`, row-major) as a PNG at
+/// `path`, atomically.
+pub(crate) fn write_rgb8_png(
+    path: &Path,
+    rgb: &[u8],
+    width: usize,
+    height: usize,
+) -> Result<(), ImageError> {
+    use image::ImageEncoder;
+    let name = || path.display().to_string();
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(
+            rgb,
+            width as u32,
+            height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|error| ImageError::Png {
+            path: name(),
+            error,
+        })?;
+    write_atomic_bytes(path, &png).map_err(|error| ImageError::Io {
+        path: name(),
+        error,
+    })
 }
 
 #[cfg(test)]
