@@ -110,7 +110,6 @@ impl Units {
         let y = full / norm;
         Units {
             scale: self.scale / y,
-            target: self.target,
             ..self
         }
     }
