@@ -152,7 +152,7 @@ def test_other_python_threads_run_during_a_render(cornell):
     t.start()
     time.sleep(0.05)
     t0 = time.monotonic()
-    cornell.render(spp=8, crop=(0.0, 0.5, 0.0, 0.5), threads=1)
+    cornell.render(spp=24, crop=(0.0, 0.5, 0.0, 0.5), threads=1)
     t1 = time.monotonic()
     stop.set()
     t.join()
