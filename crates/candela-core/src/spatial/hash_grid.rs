@@ -266,6 +266,21 @@ impl HashGrid {
     /// Calls `f(index, dist²)` once for every point within `radius` of `p`
     /// (inclusive); `index` is the point's position in the build slice.
     pub fn for_each_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(u32, f32)) {
+        self.for_each_entry_within(p, radius, |slot, d2| f(self.indices[slot], d2));
+    }
+
+    /// The build-slice index of every entry, in entry (bucket) order: a
+    /// caller that copies its items in this order into an array of its own
+    /// reads that array front to back within each bucket when it looks
+    /// them up by the entry slots of [`Self::for_each_entry_within`], instead
+    /// of jumping through the build slice (a cache miss per point found).
+    pub fn entry_order(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// Like [`Self::for_each_within`], but reports each point by its entry
+    /// slot (an index into [`Self::entry_order`]).
+    pub fn for_each_entry_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(usize, f32)) {
         let Some((lo, hi)) = self.cells.cells_around(p, radius) else {
             return;
         };
@@ -274,11 +289,14 @@ impl HashGrid {
         };
         let r2 = radius * radius;
         self.cells.for_each_bucket(lo, hi, |b| {
-            let run = self.cell_starts[b] as usize..self.cell_starts[b + 1] as usize;
-            for (q, &i) in self.points[run.clone()].iter().zip(&self.indices[run]) {
+            let (a, z) = (
+                self.cell_starts[b] as usize,
+                self.cell_starts[b + 1] as usize,
+            );
+            for (slot, q) in (a..z).zip(&self.points[a..z]) {
                 let d2 = (*q - p).length_squared();
                 if d2 <= r2 {
-                    f(i, d2);
+                    f(slot, d2);
                 }
             }
         });

@@ -153,6 +153,27 @@ fn radius_other_than_the_build_radius() {
 }
 
 #[test]
+fn entry_slots_name_the_points_of_the_entry_order() {
+    let pts = random_points(5_000, 5, Vec3::ZERO, 1.0);
+    let grid = HashGrid::build(&pts, 0.03);
+    let order = grid.entry_order();
+    // A permutation of the build slice, so a copy in entry order holds
+    // every item once.
+    let mut sorted = order.to_vec();
+    sorted.sort_unstable();
+    assert!(sorted.iter().enumerate().all(|(i, &j)| i as u32 == j));
+    for &q in &random_points(100, 6, Vec3::ZERO, 1.0) {
+        let mut by_slot = Vec::new();
+        grid.for_each_entry_within(q, 0.03, |slot, d2| {
+            assert_eq!(pts[order[slot] as usize].distance_squared(q), d2);
+            by_slot.push((order[slot], d2));
+        });
+        by_slot.sort_by_key(|&(i, _)| i);
+        assert_eq!(by_slot, brute_within(&pts, q, 0.03));
+    }
+}
+
+#[test]
 fn random_points_knn() {
     let pts = random_points(20_000, 5, Vec3::ZERO, 1.0);
     let qs = random_points(200, 6, Vec3::splat(-0.1), 1.2);

@@ -20,6 +20,7 @@
 //! filters exactly as the path tracer does.
 
 use super::light::{light_densities, LightPaths, LightVertex};
+use super::merge::MergeGrid;
 use super::mis::{weight, Factors, Partial};
 use super::VcmIntegrator;
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
@@ -35,15 +36,14 @@ use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
-use crate::spatial::HashGrid;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// What the camera pass of one iteration shares.
 pub(super) struct CameraPass<'a> {
     /// The light subpaths.
     pub light: &'a LightPaths,
-    /// Grid over `light.vertices` (merging modes).
-    pub grid: Option<&'a HashGrid>,
+    /// Grid over `light.vertices` as photons (merging modes).
+    pub grid: Option<&'a MergeGrid>,
     /// The merge radius.
     pub radius: f32,
     /// MIS constants.
@@ -340,7 +340,6 @@ impl CameraVisitor<'_, '_> {
     fn merge(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
         let Some(grid) = self.cp.grid else { return };
         let max_depth = self.vcm.settings.max_depth;
-        let verts = &self.cp.light.vertices;
         let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
         let r2 = self.cp.radius * self.cp.radius;
         let x = Surfel {
@@ -349,17 +348,13 @@ impl CameraVisitor<'_, '_> {
             w: v.wo,
         };
         let mut sum = SampledSpectrum::zero();
-        grid.for_each_within(v.p(), self.cp.radius, |i, _| {
-            let lv = &verts[i as usize];
-            if lv.v.depth + v.depth > max_depth + 1 {
+        grid.for_each_within(v.p(), self.cp.radius, |ph| {
+            if ph.depth + v.depth > max_depth + 1 {
                 return;
             }
-            let ph = Surfel {
-                p: lv.v.p(),
-                n: lv.v.it.n,
-                w: lv.v.wo,
+            let Some(c) = gather(&x, &ph.surfel, r2) else {
+                return;
             };
-            let Some(c) = gather(&x, &ph, r2) else { return };
             let wi = c.wi;
             let fv = cb.f(v.wo, wi, TransportMode::Radiance);
             if fv.is_black() {
@@ -375,11 +370,11 @@ impl CameraVisitor<'_, '_> {
                     .pdf(wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
                     .0;
                 weight(
-                    lv.mis.merge_weight(cam_dir, f),
+                    ph.merge_weight(cam_dir, f),
                     self.mis.merge_weight(cam_rev, f),
                 )
             };
-            sum += unfold(fv * lv.v.beta * w, terminated, lv.terminated);
+            sum += unfold(fv * ph.beta * w, terminated, ph.terminated);
         });
         self.l += v.beta * sum * f.merge_norm;
     }

@@ -18,7 +18,7 @@
 //! subpaths (default one per pixel of the full film), stores their
 //! non-specular vertices with their MIS quantities, and splats their
 //! connections to the camera; (2) a `HashGrid` over the stored vertices
-//! with cells of 2r; (3) [`camera`] walks one camera subpath per pixel,
+//! with cells of 2r, and compact copies of them in its order ([`merge`]); (3) [`camera`] walks one camera subpath per pixel,
 //! connecting to the light subpath of the same index and merging with every
 //! stored vertex within r. The radius of pass i (0-based) is
 //! r_i² = r₀² Π_{k=1}^{i} (k + α)/(k + 1) [Knaus & Zwicker 2011, eq. 16],
@@ -47,6 +47,7 @@
 
 mod camera;
 pub mod light;
+mod merge;
 pub mod mis;
 #[cfg(test)]
 mod mis_brute;
@@ -58,7 +59,6 @@ use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::sppm::ppm_radius2;
 use crate::math::Ray;
 use crate::sampling::hash_u64s;
-use crate::spatial::HashGrid;
 use camera::CameraPass;
 use light::LightVertex;
 use mis::Factors;
@@ -270,7 +270,7 @@ impl Integrator for VcmIntegrator {
             return PassOutcome::Done;
         }
         let grid = (t.merge && !light.vertices.is_empty() && radius > 0.0)
-            .then(|| HashGrid::build(&light.vertices, radius));
+            .then(|| merge::MergeGrid::build(&light.vertices, radius));
         let cp = CameraPass {
             light: &light,
             grid: grid.as_ref(),
