@@ -281,24 +281,37 @@ impl HashGrid {
     /// Like [`Self::for_each_within`], but reports each point by its entry
     /// slot (an index into [`Self::entry_order`]).
     pub fn for_each_entry_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(usize, f32)) {
+        let r2 = radius * radius;
+        self.for_each_candidate_run(p, radius, |run| {
+            for (slot, q) in run.clone().zip(&self.points[run]) {
+                let d2 = (*q - p).length_squared();
+                if d2 <= r2 {
+                    f(slot, d2);
+                }
+            }
+        });
+    }
+
+    /// Calls `f` with the entry slots of every bucket that may hold points
+    /// within `radius` of `p`, each bucket once; the caller tests the
+    /// distances, as `(q − p)·(q − p) ≤ radius²` to find exactly the points
+    /// of [`Self::for_each_within`]. For a caller that keeps the positions
+    /// in its own entry-ordered records, so a bucket costs one cache miss
+    /// instead of two.
+    pub fn for_each_candidate_run(
+        &self,
+        p: Vec3,
+        radius: f32,
+        mut f: impl FnMut(std::ops::Range<usize>),
+    ) {
         let Some((lo, hi)) = self.cells.cells_around(p, radius) else {
             return;
         };
         let Some((lo, hi)) = self.cells.clip(lo, hi) else {
             return;
         };
-        let r2 = radius * radius;
         self.cells.for_each_bucket(lo, hi, |b| {
-            let (a, z) = (
-                self.cell_starts[b] as usize,
-                self.cell_starts[b + 1] as usize,
-            );
-            for (slot, q) in (a..z).zip(&self.points[a..z]) {
-                let d2 = (*q - p).length_squared();
-                if d2 <= r2 {
-                    f(slot, d2);
-                }
-            }
+            f(self.cell_starts[b] as usize..self.cell_starts[b + 1] as usize);
         });
     }
 }

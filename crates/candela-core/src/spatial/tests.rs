@@ -170,6 +170,18 @@ fn entry_slots_name_the_points_of_the_entry_order() {
         });
         by_slot.sort_by_key(|&(i, _)| i);
         assert_eq!(by_slot, brute_within(&pts, q, 0.03));
+        // The candidate runs, filtered by the caller, find the same points.
+        let mut by_run = Vec::new();
+        grid.for_each_candidate_run(q, 0.03, |run| {
+            for &i in &order[run] {
+                let d2 = (pts[i as usize] - q).length_squared();
+                if d2 <= 0.03 * 0.03 {
+                    by_run.push((i, d2));
+                }
+            }
+        });
+        by_run.sort_by_key(|&(i, _)| i);
+        assert_eq!(by_run, by_slot);
     }
 }
 

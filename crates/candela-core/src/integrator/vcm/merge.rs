@@ -6,8 +6,9 @@
 //! two partial quantities merging uses (d_VCM, d_VM; [`Partial::merge_weight`]):
 //! 64 bytes, against the 272 of a whole [`LightVertex`] with its BSDF. The
 //! photons are copied once per iteration in the grid's entry order
-//! ([`HashGrid::entry_order`]), so the points of one bucket are adjacent in
-//! memory and a query reads them front to back. Reading the stored vertices
+//! ([`HashGrid::entry_order`]), so the photons of one bucket are adjacent in
+//! memory, and a query reads them front to back, positions included
+//! ([`HashGrid::for_each_candidate_run`]): one cache miss per bucket. Reading the stored vertices
 //! through the grid's indices instead was a cache miss per point found:
 //! on the Cornell box at 128² that load alone was 18 % of a VCM iteration
 //! (`perf annotate`, the merge loop was 39 % of it).
@@ -86,8 +87,14 @@ impl MergeGrid {
     /// Calls `f` with every photon within `radius` of `p` (inclusive).
     #[inline]
     pub fn for_each_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(&Photon)) {
-        self.grid
-            .for_each_entry_within(p, radius, |slot, _| f(&self.photons[slot]));
+        let r2 = radius * radius;
+        self.grid.for_each_candidate_run(p, radius, |run| {
+            for ph in &self.photons[run] {
+                if (ph.surfel.p - p).length_squared() <= r2 {
+                    f(ph);
+                }
+            }
+        });
     }
 }
 
