@@ -172,6 +172,10 @@ pub fn finish(
 ) -> Result<Box<dyn Integrator>, BuildError> {
     let e = plan.entity;
     let ck = Check::new(&e.params, &e.loc, &plan.what);
+    let footprints = match plan.kind {
+        IntegratorKind::Vcm => photon_scale::VCM_FOOTPRINT_PIXELS,
+        _ => photon_scale::FOOTPRINT_PIXELS,
+    };
     let radius = |warnings: &mut Vec<String>| match plan.radius {
         Some(r) => {
             warnings.extend(photon_scale::radius_warning(
@@ -179,10 +183,11 @@ pub fn finish(
                 &e.name,
                 r,
                 scale,
+                footprints,
             ));
             r
         }
-        None => scale.default_radius(),
+        None => scale.default_radius_in(footprints),
     };
     Ok(match plan.settings {
         Settings::Path(settings) => Box::new(PathIntegrator { settings }),

@@ -26,7 +26,7 @@ mod textures;
 
 pub use budget::parse_memory;
 pub use integrators::{kind_from_name, INTEGRATOR_NAMES};
-pub use photon_scale::{FALLBACK_SHARE, FOOTPRINT_PIXELS};
+pub use photon_scale::{FALLBACK_SHARE, FOOTPRINT_PIXELS, VCM_FOOTPRINT_PIXELS};
 pub use summary::{summarize, Counts, SceneSummary};
 
 use crate::camera::{Camera, PixelFootprint};

@@ -47,6 +47,14 @@ use candela_scene::Loc;
 /// The default SPPM/PPM radius in pixel footprints (module docs).
 pub const FOOTPRINT_PIXELS: f32 = 3.0;
 
+/// The default VCM merge radius in pixel footprints. Smaller than the
+/// photon integrators': VCM's merges compete under MIS with connections,
+/// and at one light path per pixel a merge's density π r² N_light p outweighs
+/// a connection's on diffuse paths well below SPPM's radius, so on diffuse
+/// light the radius sets the kernel bias of most of the image rather than
+/// the noise of its caustics (module docs of `integrator::vcm`).
+pub const VCM_FOOTPRINT_PIXELS: f32 = 1.0;
+
 /// Default radius as a share of the bounding box's diagonal, for scenes the
 /// camera grid does not hit.
 pub const FALLBACK_SHARE: f32 = 0.005;
@@ -129,12 +137,14 @@ impl SceneScale {
         }
     }
 
-    /// The SPPM/PPM radius when the file gives none (module docs).
-    pub fn default_radius(&self) -> f32 {
+    /// A default radius of `footprints` pixel footprints; for a scene the
+    /// camera grid does not hit, [`FALLBACK_SHARE`] of the diagonal scaled
+    /// by `footprints` / [`FOOTPRINT_PIXELS`].
+    pub fn default_radius_in(&self, footprints: f32) -> f32 {
         let d = self.diagonal();
         match self.footprint {
-            Some(w) => FOOTPRINT_PIXELS * w,
-            None if d > 0.0 => FALLBACK_SHARE * d,
+            Some(w) => footprints * w,
+            None if d > 0.0 => FALLBACK_SHARE * d * footprints / FOOTPRINT_PIXELS,
             None => 1.0,
         }
     }
@@ -160,21 +170,28 @@ pub fn photons(n: i64, scale: &SceneScale) -> u64 {
 }
 
 /// A warning for a written radius far from the scene's scale.
-pub fn radius_warning(loc: &Loc, name: &str, radius: f32, scale: &SceneScale) -> Option<String> {
+/// `footprints` is the integrator's default in pixel footprints.
+pub fn radius_warning(
+    loc: &Loc,
+    name: &str,
+    radius: f32,
+    scale: &SceneScale,
+    footprints: f32,
+) -> Option<String> {
     let diagonal = scale.diagonal();
     if diagonal <= 0.0 {
         return None;
     }
     let share = radius / diagonal;
-    let suggested = scale.default_radius();
+    let suggested = scale.default_radius_in(footprints);
     if share > 0.05 {
         Some(format!(
-            "{loc}: {name} \"radius\" {radius} is {:.0}% of the scene's diagonal ({diagonal:.3}): expect blur and slow early passes; leave it out for the default of {FOOTPRINT_PIXELS} pixel footprints ({suggested:.3e} here)",
+            "{loc}: {name} \"radius\" {radius} is {:.0}% of the scene's diagonal ({diagonal:.3}): expect blur and slow early passes; leave it out for the default of {footprints} pixel footprints ({suggested:.3e} here)",
             share * 100.0
         ))
     } else if share < 1e-5 {
         Some(format!(
-            "{loc}: {name} \"radius\" {radius} is tiny against the scene's diagonal ({diagonal:.3}): visible points will gather almost no photons; leave it out for the default of {FOOTPRINT_PIXELS} pixel footprints ({suggested:.3e} here)"
+            "{loc}: {name} \"radius\" {radius} is tiny against the scene's diagonal ({diagonal:.3}): visible points will gather almost no photons; leave it out for the default of {footprints} pixel footprints ({suggested:.3e} here)"
         ))
     } else {
         None
@@ -268,4 +285,37 @@ pub fn film_bytes(film: &Film) -> u64 {
     block
         .saturating_add(state.saturating_mul(2))
         .saturating_add(developed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn scale(footprint: Option<f32>) -> SceneScale {
+        SceneScale {
+            bounds: Bounds3::from_points(Vec3::ZERO, Vec3::new(3.0, 4.0, 0.0)),
+            footprint,
+            pixels: 100,
+        }
+    }
+
+    #[test]
+    fn default_radii_count_pixel_footprints_or_fall_back_to_the_diagonal() {
+        let s = scale(Some(0.02));
+        assert_eq!(
+            s.default_radius_in(FOOTPRINT_PIXELS),
+            FOOTPRINT_PIXELS * 0.02
+        );
+        assert_eq!(
+            s.default_radius_in(VCM_FOOTPRINT_PIXELS),
+            VCM_FOOTPRINT_PIXELS * 0.02
+        );
+        // No hit: the share of the diagonal (5 here), scaled alike.
+        let s = scale(None);
+        assert_eq!(s.default_radius_in(FOOTPRINT_PIXELS), FALLBACK_SHARE * 5.0);
+        let vcm = s.default_radius_in(VCM_FOOTPRINT_PIXELS);
+        let want = FALLBACK_SHARE * 5.0 * VCM_FOOTPRINT_PIXELS / FOOTPRINT_PIXELS;
+        assert!((vcm - want).abs() <= 1e-6 * want, "{vcm} vs {want}");
+    }
 }
