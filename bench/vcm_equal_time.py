@@ -135,9 +135,11 @@ def bench_scene(name, a, outdir, rows, vertex_info):
                 rows.append((name, integ, t, passes, secs, err, lps, mae))
                 print(f"{name:14} {integ:5} t={t:<6g} passes {passes:6} render {secs:7.2f} s "
                       f"relMSE {err:.5g} MAE {mae:.4g} light paths/s {lps:.3g}", flush=True)
-                v = re.search(r"(\d+) light vertices stored × (\d+) B", status)
+                v = re.search(r"(\d+) light vertices stored × (\d+) B(?: \(\+ (\d+) B to merge\))?",
+                              status)
                 if integ == "vcm" and v:
-                    vertex_info[name] = (int(v.group(1)), int(v.group(2)), pixels)
+                    size = int(v.group(2)) + int(v.group(3) or 0)
+                    vertex_info[name] = (int(v.group(1)), size, pixels)
     finally:
         if temporary:
             os.unlink(scene)

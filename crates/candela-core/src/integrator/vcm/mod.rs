@@ -313,9 +313,14 @@ impl Integrator for VcmIntegrator {
         );
         let stored = self.stored.load(Ordering::Relaxed);
         if stored > 0 {
+            let merge = if self.techniques.merge {
+                merge::MERGE_BYTES
+            } else {
+                0
+            };
             s.push_str(&format!(
-                ", {stored} light vertices stored × {LIGHT_VERTEX_BYTES} B = {:.1} MB",
-                (stored * LIGHT_VERTEX_BYTES as u64) as f64 / 1e6
+                ", {stored} light vertices stored × {LIGHT_VERTEX_BYTES} B (+ {merge} B to merge) = {:.1} MB",
+                (stored * (LIGHT_VERTEX_BYTES + merge) as u64) as f64 / 1e6
             ));
         }
         Some(s)
