@@ -266,30 +266,24 @@ impl HashGrid {
     /// Calls `f(index, dist²)` once for every point within `radius` of `p`
     /// (inclusive); `index` is the point's position in the build slice.
     pub fn for_each_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(u32, f32)) {
-        self.for_each_entry_within(p, radius, |slot, d2| f(self.indices[slot], d2));
+        let r2 = radius * radius;
+        self.for_each_candidate_run(p, radius, |run| {
+            for (q, &i) in self.points[run.clone()].iter().zip(&self.indices[run]) {
+                let d2 = (*q - p).length_squared();
+                if d2 <= r2 {
+                    f(i, d2);
+                }
+            }
+        });
     }
 
     /// The build-slice index of every entry, in entry (bucket) order: a
     /// caller that copies its items in this order into an array of its own
     /// reads that array front to back within each bucket when it looks
-    /// them up by the entry slots of [`Self::for_each_entry_within`], instead
-    /// of jumping through the build slice (a cache miss per point found).
+    /// them up by the entry slots of [`Self::for_each_candidate_run`],
+    /// instead of jumping through the build slice (a cache miss per point).
     pub fn entry_order(&self) -> &[u32] {
         &self.indices
-    }
-
-    /// Like [`Self::for_each_within`], but reports each point by its entry
-    /// slot (an index into [`Self::entry_order`]).
-    pub fn for_each_entry_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(usize, f32)) {
-        let r2 = radius * radius;
-        self.for_each_candidate_run(p, radius, |run| {
-            for (slot, q) in run.clone().zip(&self.points[run]) {
-                let d2 = (*q - p).length_squared();
-                if d2 <= r2 {
-                    f(slot, d2);
-                }
-            }
-        });
     }
 
     /// Calls `f` with the entry slots of every bucket that may hold points

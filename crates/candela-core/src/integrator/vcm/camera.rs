@@ -370,7 +370,7 @@ impl CameraVisitor<'_, '_> {
                     .pdf(wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
                     .0;
                 weight(
-                    ph.merge_weight(cam_dir, f),
+                    ph.mis.merge_weight(cam_dir, f),
                     self.mis.merge_weight(cam_rev, f),
                 )
             };

@@ -3,18 +3,19 @@
 //!
 //! A merge reads, for every light vertex within r of a camera vertex, only
 //! its position, geometric normal, `wo`, β, depth, dispersion flag and the
-//! two partial quantities merging uses (d_VCM, d_VM; [`Partial::merge_weight`]):
-//! 64 bytes, against the 272 of a whole [`LightVertex`] with its BSDF. The
-//! photons are copied once per iteration in the grid's entry order
+//! vertex's partial MIS quantities ([`Partial::merge_weight`]): 72 bytes,
+//! against the 272 of a whole [`LightVertex`] with its BSDF. The photons are
+//! copied once per iteration in the grid's entry order
 //! ([`HashGrid::entry_order`]), so the photons of one bucket are adjacent in
 //! memory, and a query reads them front to back, positions included
-//! ([`HashGrid::for_each_candidate_run`]): one cache miss per bucket. Reading the stored vertices
-//! through the grid's indices instead was a cache miss per point found:
+//! ([`HashGrid::for_each_candidate_run`]): one cache miss per bucket.
+//! Reading the stored vertices through the grid's indices instead was a
+//! cache miss per point found:
 //! on the Cornell box at 128² that load alone was 18 % of a VCM iteration
 //! (`perf annotate`, the merge loop was 39 % of it).
 
 use super::light::LightVertex;
-use super::mis::{Factors, Partial};
+use super::mis::Partial;
 use crate::integrator::gather::Surfel;
 use crate::math::Vec3;
 use crate::spatial::HashGrid;
@@ -32,10 +33,8 @@ pub(super) struct Photon {
     pub surfel: Surfel,
     /// The light subpath's throughput (power) at the vertex.
     pub beta: SampledSpectrum,
-    /// d_VCM of the vertex (merging uses no d_VC).
-    pub d_vcm: f32,
-    /// d_VM of the vertex.
-    pub d_vm: f32,
+    /// The vertex's partial MIS quantities.
+    pub mis: Partial,
     /// Surface vertices of the light subpath up to this one.
     pub depth: u32,
     /// Its subpath kept only the hero wavelength.
@@ -51,22 +50,10 @@ impl Photon {
                 w: lv.v.wo,
             },
             beta: lv.v.beta,
-            d_vcm: lv.mis.d_vcm,
-            d_vm: lv.mis.d_vm,
+            mis: lv.mis,
             depth: lv.v.depth,
             terminated: lv.terminated,
         }
-    }
-
-    /// The light side's partial merge weight, as [`Partial::merge_weight`].
-    #[inline]
-    pub fn merge_weight(&self, pdf: f32, f: &Factors) -> f32 {
-        Partial {
-            d_vcm: self.d_vcm,
-            d_vc: 0.0,
-            d_vm: self.d_vm,
-        }
-        .merge_weight(pdf, f)
     }
 }
 
@@ -100,35 +87,5 @@ impl MergeGrid {
                 }
             }
         });
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_photon_weight_is_the_vertex_weight() {
-        let p = Partial {
-            d_vcm: 0.3,
-            d_vc: 7.0,
-            d_vm: 2.5,
-        };
-        let f = Factors::new(0.05, 1000.0, true, true);
-        let ph = Photon {
-            surfel: Surfel {
-                p: Vec3::ZERO,
-                n: Vec3::Z,
-                w: Vec3::Z,
-            },
-            beta: SampledSpectrum::splat(1.0),
-            d_vcm: p.d_vcm,
-            d_vm: p.d_vm,
-            depth: 1,
-            terminated: false,
-        };
-        for pdf in [0.0, 0.2, 3.0] {
-            assert_eq!(ph.merge_weight(pdf, &f), p.merge_weight(pdf, &f));
-        }
     }
 }
