@@ -198,3 +198,39 @@ fn candela_core_modules_form_no_circle() {
     bad.get_mut("scene").map(|d| d.insert("build".to_string()));
     assert!(cycle(&bad).is_some());
 }
+
+/// The files whose non-comment lines hold an unsafe block, function or
+/// impl, or allow unsafe code (the patterns are spelt in two parts so this
+/// file does not match itself).
+fn files_with_unsafe(files: &[PathBuf]) -> Vec<String> {
+    let word = ["un", "safe"].concat();
+    let patterns = [" {", " fn", " impl", "_code)"].map(|p| format!("{word}{p}"));
+    files
+        .iter()
+        .filter(|f| {
+            let text = std::fs::read_to_string(f).unwrap_or_default();
+            text.lines().any(|l| {
+                !l.trim_start().starts_with("//") && patterns.iter().any(|p| l.contains(p.as_str()))
+            })
+        })
+        .map(|f| f.to_string_lossy().replace('\\', "/"))
+        .collect()
+}
+
+#[test]
+fn unsafe_code_lives_in_the_bvh_intrinsics_module_alone() {
+    // The workspace denies unsafe code; accel/simd.rs allows it for CPU
+    // intrinsics behind a safe API, and no other file may.
+    let found = files_with_unsafe(&all_sources());
+    assert!(
+        found
+            .iter()
+            .all(|f| f.ends_with("candela-core/src/accel/simd.rs")),
+        "unsafe outside accel/simd.rs: {found:?}"
+    );
+    assert_eq!(
+        found.len(),
+        1,
+        "the scanner must see accel/simd.rs: {found:?}"
+    );
+}

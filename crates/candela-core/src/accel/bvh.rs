@@ -1,22 +1,12 @@
 //! The wide BVH: node layout, collapse of the binary tree, and traversal.
 
 use super::build::{build_tree, BuildNode, BuildTree, MAX_LEAF, PACK};
+use super::node::{Node, NodeTest, RayBoxes, EMPTY_CHILD, WIDTH};
+use super::simd::Stack;
 use super::triangle4::{Tri4Ray, TriPack, EMPTY_LANE, OTHER_TAG};
-use crate::math::{gamma, Bounds3, Ray, Vec3};
+use crate::math::{Bounds3, Ray, Vec3};
 use crate::shape::{TriangleIntersection, WatertightRay};
-use wide::{f32x8, CmpLe};
 
-/// One SIMD vector per node axis and bound: a lane per child.
-type Lanes = f32x8;
-
-/// Children per node.
-const WIDTH: usize = 8;
-/// Traversal stack entries on the call stack; deeper trees (only from
-/// adversarial input: see [`super::build`]) use a heap stack of
-/// [`Bvh::stack_need`] entries.
-const STACK: usize = 64;
-/// Child code of an unused slot.
-const EMPTY_CHILD: u32 = u32::MAX;
 /// Tag of a leaf's child code; bits 28–30 hold the pack count − 1 and bits
 /// 0–27 the first pack.
 const LEAF_TAG: u32 = 1 << 31;
@@ -24,17 +14,6 @@ const LEAF_TAG: u32 = 1 << 31;
 const MAX_PACKS: usize = 1 << 28;
 
 const _: () = assert!(MAX_LEAF.div_ceil(PACK) <= 8);
-
-/// The children's boxes, as `b[0]` = lower and `b[1]` = upper corners with
-/// one vector per axis (a lane per child), and their child codes.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-struct Node {
-    b: [[Lanes; 3]; 2],
-    child: [u32; WIDTH],
-}
-
-const _: () = assert!(std::mem::size_of::<Node>() == 64 * (7 * WIDTH).div_ceil(16));
 
 /// An 8-wide bounding volume hierarchy over items given by their bounds.
 /// Items that are triangles are stored in SIMD packs and tested by the
@@ -47,9 +26,6 @@ pub struct Bvh {
     items: usize,
     has_other: bool,
     depth: usize,
-    /// Stack entries a traversal needs at most: the largest sum of
-    /// (children − 1) along a root-to-leaf path, plus one.
-    stack_need: usize,
 }
 
 /// The closest hit found by [`Bvh::intersect`].
@@ -118,13 +94,12 @@ impl Bvh {
         };
         match &tree.root {
             BuildNode::Interior { .. } => {
-                out.node(&tree.root, 1);
+                out.node(&tree.root);
             }
             leaf => {
                 let code = out.leaf(leaf);
                 let b = leaf.bounds();
-                out.bvh.nodes.push(node_of(&[(b, code)]));
-                out.bvh.stack_need = 1;
+                out.bvh.nodes.push(Node::new(&[(b, code)]));
             }
         }
         bvh.nodes.shrink_to_fit();
@@ -184,6 +159,18 @@ impl Bvh {
         leaves
     }
 
+    /// Prefetches the first cache lines of a child.
+    #[inline(always)]
+    fn prefetch_child(&self, code: u32) {
+        if code & LEAF_TAG == 0 {
+            super::simd::prefetch_all(&self.nodes[code as usize]);
+        } else {
+            self.leaf_packs(code)
+                .iter()
+                .for_each(super::simd::prefetch_all);
+        }
+    }
+
     /// The packs of a leaf code.
     #[inline(always)]
     fn leaf_packs(&self, code: u32) -> &[TriPack] {
@@ -195,7 +182,21 @@ impl Bvh {
     /// Closest hit with `t < t_max`: packed triangles are tested here, other
     /// items by `other(item, ray, t_max)`, which returns the item's hit `t`
     /// (`< t_max`) or `None`.
-    pub fn intersect<F>(&self, ray: &Ray, t_max: f32, mut other: F) -> Option<BvhHit>
+    pub fn intersect<F>(&self, ray: &Ray, t_max: f32, other: F) -> Option<BvhHit>
+    where
+        F: FnMut(u32, &Ray, f32) -> Option<f32>,
+    {
+        super::simd::intersect(self, ray, t_max, other)
+    }
+
+    /// [`Bvh::intersect`] with node kernel `K` (see [`super::simd`]).
+    #[inline(always)]
+    pub(super) fn intersect_with<K: NodeTest, F>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut other: F,
+    ) -> Option<BvhHit>
     where
         F: FnMut(u32, &Ray, f32) -> Option<f32>,
     {
@@ -204,28 +205,18 @@ impl Bvh {
         }
         let boxes = RayBoxes::new(ray);
         let tri = Tri4Ray::new(&WatertightRay::new(ray));
-        let (mut small, mut big) = ([(0u32, 0.0f32); STACK], Vec::new());
-        let stack: &mut [(u32, f32)] = if self.stack_need <= STACK {
-            &mut small
-        } else {
-            big.resize(self.stack_need, (0, 0.0));
-            &mut big
-        };
-        let (mut sp, mut t_max, mut best) = (0usize, t_max, None);
+        let mut stack = Stack::<(u32, f32)>::new();
+        let (mut t_max, mut best) = (t_max, None);
         let mut current = 0u32;
         loop {
             if current & LEAF_TAG == 0 {
                 let mut order = [(0u32, 0.0f32); WIDTH];
-                let k = hit_children_nearest_first(
-                    &self.nodes[current as usize],
-                    &boxes,
-                    t_max,
-                    &mut order,
-                );
+                let node = &self.nodes[current as usize];
+                let k = hit_children_nearest_first(node, K::hits(&boxes, node, t_max), &mut order);
                 if k > 0 {
                     for &e in order[1..k].iter().rev() {
-                        stack[sp] = e;
-                        sp += 1;
+                        self.prefetch_child(e.0);
+                        stack.push(e);
                     }
                     current = order[0].0;
                     continue;
@@ -250,11 +241,9 @@ impl Bvh {
             }
             // Pop the next subtree that can still hold a closer hit.
             loop {
-                if sp == 0 {
+                let Some((code, t)) = stack.pop() else {
                     return best;
-                }
-                sp -= 1;
-                let (code, t) = stack[sp];
+                };
                 if t <= t_max {
                     current = code;
                     break;
@@ -265,7 +254,21 @@ impl Bvh {
 
     /// Any hit with `t < t_max`: true as soon as a packed triangle or
     /// `other(item, ray, t_max)` reports one.
-    pub fn intersect_p<F>(&self, ray: &Ray, t_max: f32, mut other: F) -> bool
+    pub fn intersect_p<F>(&self, ray: &Ray, t_max: f32, other: F) -> bool
+    where
+        F: FnMut(u32, &Ray, f32) -> bool,
+    {
+        super::simd::intersect_p(self, ray, t_max, other)
+    }
+
+    /// [`Bvh::intersect_p`] with node kernel `K` (see [`super::simd`]).
+    #[inline(always)]
+    pub(super) fn intersect_p_with<K: NodeTest, F>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut other: F,
+    ) -> bool
     where
         F: FnMut(u32, &Ray, f32) -> bool,
     {
@@ -274,25 +277,18 @@ impl Bvh {
         }
         let boxes = RayBoxes::new(ray);
         let tri = Tri4Ray::new(&WatertightRay::new(ray));
-        let (mut small, mut big) = ([0u32; STACK], Vec::new());
-        let stack: &mut [u32] = if self.stack_need <= STACK {
-            &mut small
-        } else {
-            big.resize(self.stack_need, 0);
-            &mut big
-        };
-        let mut sp = 0usize;
+        let mut stack = Stack::<u32>::new();
         let mut current = 0u32;
         loop {
             if current & LEAF_TAG == 0 {
                 let node = &self.nodes[current as usize];
-                let (mut mask, _) = boxes.hits(node, t_max);
+                let (mut mask, _) = K::hits(&boxes, node, t_max);
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     if node.child[i] != EMPTY_CHILD {
-                        stack[sp] = node.child[i];
-                        sp += 1;
+                        self.prefetch_child(node.child[i]);
+                        stack.push(node.child[i]);
                     }
                 }
             } else {
@@ -305,11 +301,10 @@ impl Bvh {
                     }
                 }
             }
-            if sp == 0 {
-                return false;
+            match stack.pop() {
+                Some(code) => current = code,
+                None => return false,
             }
-            sp -= 1;
-            current = stack[sp];
         }
     }
 }
@@ -321,66 +316,6 @@ fn other_items(pack: &TriPack) -> impl Iterator<Item = u32> + '_ {
         .iter()
         .filter(|&&id| id != EMPTY_LANE && id & OTHER_TAG != 0)
         .map(|&id| id & !OTHER_TAG)
-}
-
-/// A ray's constants for the slab test, splatted over the lanes.
-struct RayBoxes {
-    o: [Lanes; 3],
-    inv_dir: [Lanes; 3],
-    /// Per axis: true when the direction is negative (the near plane is the upper one).
-    neg: [bool; 3],
-}
-
-impl RayBoxes {
-    /// Reciprocal direction and its signs.
-    #[inline]
-    fn new(ray: &Ray) -> Self {
-        let inv = ray.d.recip();
-        RayBoxes {
-            o: [ray.o.x, ray.o.y, ray.o.z].map(Lanes::splat),
-            inv_dir: [inv.x, inv.y, inv.z].map(Lanes::splat),
-            neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
-        }
-    }
-
-    /// Slab test of a node's boxes against `(0, t_max)`: the mask of
-    /// hit children and their entry distances. The far distances are widened
-    /// by 1 + 2γ₃ so rounding never culls a box the ray touches [pbrt-v4
-    /// §6.8.2]; `maxps`/`minps` return their second operand when the first
-    /// is NaN, so a ray lying in a slab's boundary plane (0·∞) counts as
-    /// inside that slab [Ize 2013, "Robust BVH ray traversal"]. Empty slots
-    /// have inverted boxes and never hit.
-    #[inline(always)]
-    fn hits(&self, n: &Node, t_max: f32) -> (u32, Lanes) {
-        let widen = Lanes::splat(1.0 + 2.0 * gamma(3));
-        let (mut t0, mut t1) = (Lanes::ZERO, Lanes::splat(t_max));
-        for axis in 0..3 {
-            let neg = self.neg[axis] as usize;
-            let near = (n.b[neg][axis] - self.o[axis]) * self.inv_dir[axis];
-            let far = (n.b[1 - neg][axis] - self.o[axis]) * self.inv_dir[axis] * widen;
-            t0 = near.fast_max(t0);
-            t1 = far.fast_min(t1);
-        }
-        (t0.cmp_le(t1).move_mask() as u32, t0)
-    }
-}
-
-/// A node over up to `WIDTH` `(bounds, child code)` pairs.
-fn node_of(children: &[(Bounds3, u32)]) -> Node {
-    let mut b = [[[f32::INFINITY; WIDTH]; 3], [[f32::NEG_INFINITY; WIDTH]; 3]];
-    let mut child = [EMPTY_CHILD; WIDTH];
-    for (i, (bounds, code)) in children.iter().enumerate() {
-        let [lo, hi] = &mut b;
-        for (axis, (lo, hi)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
-            lo[i] = bounds.min[axis];
-            hi[i] = bounds.max[axis];
-        }
-        child[i] = *code;
-    }
-    Node {
-        b: b.map(|c| c.map(Lanes::new)),
-        child,
-    }
 }
 
 /// Flattening of the binary tree into wide nodes and packs.
@@ -395,7 +330,7 @@ impl<T: Fn(u32) -> Option<[Vec3; 3]>> Collapse<'_, T> {
     /// `WIDTH` by repeatedly opening the interior child of largest surface
     /// area (Wald et al. 2008, "Getting rid of packets"). `need` is the
     /// stack a traversal may hold on reaching it. Returns its index.
-    fn node(&mut self, node: &BuildNode, need: usize) -> u32 {
+    fn node(&mut self, node: &BuildNode) -> u32 {
         let mut kids: Vec<&BuildNode> = match node {
             BuildNode::Interior { children, .. } => children.iter().collect(),
             leaf => vec![leaf],
@@ -417,20 +352,18 @@ impl<T: Fn(u32) -> Option<[Vec3; 3]>> Collapse<'_, T> {
             }
         }
         let index = self.bvh.nodes.len();
-        self.bvh.nodes.push(node_of(&[]));
-        let need = need + kids.len() - 1;
-        self.bvh.stack_need = self.bvh.stack_need.max(need);
+        self.bvh.nodes.push(Node::new(&[]));
         let children: Vec<(Bounds3, u32)> = kids
             .iter()
             .map(|k| {
                 let code = match k {
-                    BuildNode::Interior { .. } => self.node(k, need),
+                    BuildNode::Interior { .. } => self.node(k),
                     leaf => self.leaf(leaf),
                 };
                 (k.bounds(), code)
             })
             .collect();
-        self.bvh.nodes[index] = node_of(&children);
+        self.bvh.nodes[index] = Node::new(&children);
         index as u32
     }
 
@@ -456,17 +389,15 @@ impl<T: Fn(u32) -> Option<[Vec3; 3]>> Collapse<'_, T> {
     }
 }
 
-/// Writes the children of `node` that the ray hits before `t_max` into
-/// `order`, nearest first (insertion sort over at most 8), and returns how many.
+/// Writes the children of `node` that the ray hits (`hits`, from
+/// [`NodeTest::hits`]) into `order`, nearest first (insertion sort over at
+/// most 8), and returns how many.
 #[inline(always)]
 fn hit_children_nearest_first(
     node: &Node,
-    boxes: &RayBoxes,
-    t_max: f32,
+    (mut mask, t_near): (u32, [f32; WIDTH]),
     order: &mut [(u32, f32); WIDTH],
 ) -> usize {
-    let (mut mask, t_near) = boxes.hits(node, t_max);
-    let t_near = t_near.to_array();
     let mut k = 0;
     while mask != 0 {
         let i = mask.trailing_zeros() as usize;
