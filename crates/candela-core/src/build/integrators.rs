@@ -12,13 +12,13 @@ use super::check::{Check, Domain};
 use super::photon_scale::{self, SceneScale};
 use super::{BuildError, Overrides};
 use crate::integrator::photonmap::Kernel;
-use crate::light::LightSelection;
 use crate::integrator::wavelengths::{DEFAULT_GROUPS, MAX_GROUPS};
 use crate::integrator::{
     BdptIntegrator, BdptSettings, Integrator, IntegratorKind, LightTracer, LightTracerSettings,
     PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator,
     PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator, VcmMode, VcmSettings, Visualize,
 };
+use crate::light::LightSelection;
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription};
 
 /// The settings of each integrator, read and checked.
@@ -138,7 +138,10 @@ pub fn integrator<'a>(
     // Photons are shot by power, as pbrt-v4's SPPM does.
     let photons = matches!(
         kind,
-        IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::PhotonMap | IntegratorKind::Vcm
+        IntegratorKind::Sppm
+            | IntegratorKind::Ppm
+            | IntegratorKind::PhotonMap
+            | IntegratorKind::Vcm
     );
     let light_selection = match selection {
         LightSelection::Uniform if photons => LightSelection::Power,

@@ -181,7 +181,9 @@ impl PathIntegrator {
             let wo = -ray.d.normalize();
             if bsdf.flags().is_non_specular() {
                 let r = Receiver::at_hit(&si, &bsdf, wo);
-                if let Some(ls) = sample_light(scene, scene.nee_light_sampler(), &r, lambda, sampler) {
+                if let Some(ls) =
+                    sample_light(scene, scene.nee_light_sampler(), &r, lambda, sampler)
+                {
                     st.l += st.beta * ls.bsdf_mis_weighted(scene, &r);
                 }
             }

@@ -61,7 +61,13 @@ pub struct LightBounds {
 
 impl LightBounds {
     /// Bounds from a box, a normal cone, the emission spread and the power.
-    pub fn new(bounds: Bounds3, normals: DirectionCone, phi: f32, cos_theta_e: f32, two_sided: bool) -> Self {
+    pub fn new(
+        bounds: Bounds3,
+        normals: DirectionCone,
+        phi: f32,
+        cos_theta_e: f32,
+        two_sided: bool,
+    ) -> Self {
         Self {
             bounds,
             phi,
@@ -148,7 +154,9 @@ fn subtended_sin_cos(bounds: &Bounds3, p: Vec3) -> (f32, f32) {
 /// The importance of `b` at `p` with normal `n`; finite and ≥ 0.
 pub(crate) fn importance(b: &LightBounds, p: Vec3, n: Vec3) -> f32 {
     let pc = b.bounds.centroid();
-    let d2 = p.distance_squared(pc).max(b.bounds.diagonal().length() / 2.0);
+    let d2 = p
+        .distance_squared(pc)
+        .max(b.bounds.diagonal().length() / 2.0);
     let wi = (p - pc).normalize_or_zero();
     let mut cos_w = b.w.dot(wi);
     if b.two_sided {
@@ -218,5 +226,11 @@ impl Light {
 
 /// Bounds of a light emitting from point `p` in every direction.
 pub(crate) fn isotropic_point(p: Vec3, phi: f32) -> LightBounds {
-    LightBounds::new(Bounds3::from_point(p), DirectionCone::entire_sphere(), phi, 0.0, false)
+    LightBounds::new(
+        Bounds3::from_point(p),
+        DirectionCone::entire_sphere(),
+        phi,
+        0.0,
+        false,
+    )
 }

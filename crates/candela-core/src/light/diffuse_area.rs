@@ -349,6 +349,12 @@ impl DiffuseAreaLight {
     pub(super) fn bounds(&self) -> LightBounds {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
         let phi = scalar(|l| self.phi(l)) / sides;
-        LightBounds::new(self.shape.bounds(), self.shape.normal_bounds(), phi, 0.0, self.two_sided)
+        LightBounds::new(
+            self.shape.bounds(),
+            self.shape.normal_bounds(),
+            phi,
+            0.0,
+            self.two_sided,
+        )
     }
 }

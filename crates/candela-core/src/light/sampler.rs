@@ -55,7 +55,10 @@ impl LightSampler {
     /// Power-proportional selection; falls back to uniform when every light
     /// has zero power (pbrt-v4 behaviour).
     pub fn power(lights: &[Light]) -> Self {
-        let power: Vec<f32> = lights.iter().map(|l| scalar(|lambda| l.phi(lambda))).collect();
+        let power: Vec<f32> = lights
+            .iter()
+            .map(|l| scalar(|lambda| l.phi(lambda)))
+            .collect();
         if lights.is_empty() || power.iter().all(|&p| p == 0.0) {
             return Self::uniform(lights);
         }

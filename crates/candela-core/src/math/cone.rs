@@ -125,7 +125,10 @@ mod tests {
                 let slack = 4.0 * f32::EPSILON;
                 for c in [a, b] {
                     if c.w.dot(d) >= c.cos_theta {
-                        assert!(u.w.dot(d) >= u.cos_theta - slack, "{a:?} ∪ {b:?} = {u:?} misses {d:?}");
+                        assert!(
+                            u.w.dot(d) >= u.cos_theta - slack,
+                            "{a:?} ∪ {b:?} = {u:?} misses {d:?}"
+                        );
                     }
                 }
             }
@@ -142,6 +145,9 @@ mod tests {
         let inside = DirectionCone::bound_subtended(&b, Vec3::new(0.0, 0.0, 1.5));
         assert_eq!(inside.cos_theta, -1.0);
         let point = Bounds3::from_point(Vec3::ZERO);
-        assert_eq!(DirectionCone::bound_subtended(&point, Vec3::ZERO).cos_theta, -1.0);
+        assert_eq!(
+            DirectionCone::bound_subtended(&point, Vec3::ZERO).cos_theta,
+            -1.0
+        );
     }
 }

@@ -26,8 +26,8 @@
 //!   whole patch has one orientation (pbrt-v4 checks each corner's own
 //!   normal only, which a twisted patch defeats); otherwise the whole sphere.
 
-use super::{BilinearPatch, Shape, Triangle};
 use super::bilinear_math::partials;
+use super::{BilinearPatch, Shape, Triangle};
 use crate::math::{DirectionCone, Vec2, Vec3};
 
 impl Shape {
@@ -105,7 +105,11 @@ impl BilinearPatch {
             None if flips => -1.0,
             None => 1.0,
         };
-        let normals: Vec<Vec3> = raw.iter().filter(|n| **n != Vec3::ZERO).map(|n| side * *n).collect();
+        let normals: Vec<Vec3> = raw
+            .iter()
+            .filter(|n| **n != Vec3::ZERO)
+            .map(|n| side * *n)
+            .collect();
         let Some(w) = normals.iter().sum::<Vec3>().try_normalize() else {
             return DirectionCone::entire_sphere();
         };
@@ -163,7 +167,11 @@ mod tests {
                 continue;
             };
             let d = cone.w.dot(ss.intr.n);
-            assert!(d >= cone.cos_theta - ROUND_OFF, "{shape:?}: n {:?} outside {cone:?}", ss.intr.n);
+            assert!(
+                d >= cone.cos_theta - ROUND_OFF,
+                "{shape:?}: n {:?} outside {cone:?}",
+                ss.intr.n
+            );
         }
     }
 
@@ -176,10 +184,16 @@ mod tests {
             let p: Vec<Vec3> = (0..4).map(|_| u3(&mut r)).collect();
             let n = random_normals(&mut r, 3);
             let tri = TriangleMesh::new(&t, rev, vec![0, 1, 2], p[..3].to_vec(), n, None, None);
-            assert_bounds_normals(&Shape::Triangle(Triangle::new(Arc::new(tri.unwrap()), 0)), &mut r);
+            assert_bounds_normals(
+                &Shape::Triangle(Triangle::new(Arc::new(tri.unwrap()), 0)),
+                &mut r,
+            );
             let n = random_normals(&mut r, 4);
             let blp = BilinearPatchMesh::new(&t, rev, vec![0, 1, 2, 3], p, n, None, None);
-            assert_bounds_normals(&Shape::BilinearPatch(BilinearPatch::new(Arc::new(blp.unwrap()), 0)), &mut r);
+            assert_bounds_normals(
+                &Shape::BilinearPatch(BilinearPatch::new(Arc::new(blp.unwrap()), 0)),
+                &mut r,
+            );
             let disk = Disk::new(Arc::new(t), rev, r.uniform_f32(), 1.0, 0.2, 300.0);
             assert_bounds_normals(&Shape::Disk(disk), &mut r);
         }

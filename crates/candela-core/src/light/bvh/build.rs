@@ -44,11 +44,19 @@ pub(super) struct Builder<'a> {
 impl Builder<'_> {
     /// Builds the subtree of `items` (light index, bounds) at `depth` with
     /// trail `trail`; returns its bounds.
-    pub fn node(&mut self, items: &mut [(u32, LightBounds)], trail: u64, depth: u32) -> LightBounds {
+    pub fn node(
+        &mut self,
+        items: &mut [(u32, LightBounds)],
+        trail: u64,
+        depth: u32,
+    ) -> LightBounds {
         debug_assert!(!items.is_empty());
         if let [(light, lb)] = items {
             self.slots[*light as usize] = Slot::Tree(trail);
-            self.nodes.push(LightBvhNode::leaf(*light, CompactLightBounds::new(lb, &self.all)));
+            self.nodes.push(LightBvhNode::leaf(
+                *light,
+                CompactLightBounds::new(lb, &self.all),
+            ));
             return *lb;
         }
         let mid = split(items, depth);
@@ -88,10 +96,14 @@ fn split(items: &mut [(u32, LightBounds)], depth: u32) -> usize {
 
 /// Splits at the median centroid along the centroids' longest axis.
 fn median_split(items: &mut [(u32, LightBounds)]) -> usize {
-    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.union_point(it.1.centroid()));
+    let cb = items
+        .iter()
+        .fold(Bounds3::EMPTY, |b, it| b.union_point(it.1.centroid()));
     let dim = cb.max_extent();
     let mid = items.len() / 2;
-    items.select_nth_unstable_by(mid, |a, b| a.1.centroid()[dim].total_cmp(&b.1.centroid()[dim]));
+    items.select_nth_unstable_by(mid, |a, b| {
+        a.1.centroid()[dim].total_cmp(&b.1.centroid()[dim])
+    });
     mid
 }
 
@@ -106,8 +118,12 @@ fn bucket_of(centroids: &Bounds3, c: f32, dim: usize) -> usize {
 /// the first side, centroid bounds); `None` when none has a finite,
 /// positive cost.
 fn best_bucket_split(items: &[(u32, LightBounds)]) -> Option<(usize, usize, Bounds3)> {
-    let bounds = items.iter().fold(Bounds3::EMPTY, |b, it| b.union(it.1.bounds));
-    let centroids = items.iter().fold(Bounds3::EMPTY, |b, it| b.union_point(it.1.centroid()));
+    let bounds = items
+        .iter()
+        .fold(Bounds3::EMPTY, |b, it| b.union(it.1.bounds));
+    let centroids = items
+        .iter()
+        .fold(Bounds3::EMPTY, |b, it| b.union_point(it.1.centroid()));
     let mut best: Option<(f32, usize, usize)> = None;
     for dim in 0..3 {
         if centroids.max[dim] == centroids.min[dim] {
@@ -120,9 +136,12 @@ fn best_bucket_split(items: &[(u32, LightBounds)]) -> Option<(usize, usize, Boun
         }
         for i in 0..BUCKETS - 1 {
             let side = |r: std::ops::Range<usize>| {
-                buckets[r].iter().flatten().fold(None, |acc: Option<LightBounds>, b| {
-                    Some(acc.map_or(*b, |a| a.union(b)))
-                })
+                buckets[r]
+                    .iter()
+                    .flatten()
+                    .fold(None, |acc: Option<LightBounds>, b| {
+                        Some(acc.map_or(*b, |a| a.union(b)))
+                    })
             };
             let (Some(b0), Some(b1)) = (side(0..i + 1), side(i + 1..BUCKETS)) else {
                 continue;

@@ -50,12 +50,10 @@ impl CompactLightBounds {
         let packed = quantize_cos(cos_o)
             | (quantize_cos(lb.cos_theta_e) << 15)
             | (u32::from(lb.two_sided) << 30);
-        let mut qb = [[0u16; 3]; 2];
-        for c in 0..3 {
-            let (lo, hi) = (all.min[c], all.max[c]);
-            qb[0][c] = quantize_coord(lb.bounds.min[c], lo, hi, false);
-            qb[1][c] = quantize_coord(lb.bounds.max[c], lo, hi, true);
-        }
+        let q = |corner: crate::math::Vec3, up: bool| {
+            std::array::from_fn(|c| quantize_coord(corner[c], all.min[c], all.max[c], up))
+        };
+        let qb = [q(lb.bounds.min, false), q(lb.bounds.max, true)];
         Self {
             w,
             phi: lb.phi,
@@ -198,13 +196,24 @@ mod tests {
             let b = all.min + (all.max - all.min) * Vec3::new(r(), r(), r());
             let w = sample_uniform_sphere(Vec2::new(r(), r()));
             let (cos_o, cos_e) = (2.0 * r() - 1.0, 2.0 * r() - 1.0);
-            let lb = LightBounds::new(Bounds3::from_points(a, b), DirectionCone::new(w, cos_o), r(), cos_e, r() < 0.5);
+            let lb = LightBounds::new(
+                Bounds3::from_points(a, b),
+                DirectionCone::new(w, cos_o),
+                r(),
+                cos_e,
+                r() < 0.5,
+            );
             let d = CompactLightBounds::new(&lb, &all).decode(&all);
-            assert!(d.bounds.min.cmple(lb.bounds.min).all() && d.bounds.max.cmpge(lb.bounds.max).all());
+            assert!(
+                d.bounds.min.cmple(lb.bounds.min).all() && d.bounds.max.cmpge(lb.bounds.max).all()
+            );
             assert!(d.cos_theta_o <= lb.cos_theta_o && d.cos_theta_e <= lb.cos_theta_e);
             assert_eq!((d.phi, d.two_sided), (lb.phi, lb.two_sided));
             let theta_gap = angle_between_f64(d.w, lb.w) + (lb.cos_theta_o as f64).acos();
-            assert!(theta_gap <= (d.cos_theta_o as f64).acos() + 1e-6, "{lb:?} → {d:?}");
+            assert!(
+                theta_gap <= (d.cos_theta_o as f64).acos() + 1e-6,
+                "{lb:?} → {d:?}"
+            );
         }
     }
 

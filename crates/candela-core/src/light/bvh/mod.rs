@@ -234,7 +234,11 @@ impl BvhLightSampler {
                 return 0.0;
             }
             pmf *= pr[side];
-            i = if side == 0 { i + 1 } else { node.target() as usize };
+            i = if side == 0 {
+                i + 1
+            } else {
+                node.target() as usize
+            };
             trail >>= 1;
         }
     }

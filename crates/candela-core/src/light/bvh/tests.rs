@@ -30,18 +30,38 @@ fn area(shape: Shape, l: f32, two_sided: bool) -> Light {
 /// The frame at `c` whose +z is `n`.
 fn frame_at(c: Vec3, n: Vec3) -> Transform {
     let f = Frame::from_z(n);
-    let m = Mat4::from_cols(f.x.extend(0.0), f.y.extend(0.0), f.z.extend(0.0), c.extend(1.0));
+    let m = Mat4::from_cols(
+        f.x.extend(0.0),
+        f.y.extend(0.0),
+        f.z.extend(0.0),
+        c.extend(1.0),
+    );
     Transform::new(m, m.inverse())
 }
 
 /// A disk of radius `radius` at `c` facing `n`.
 fn disk(c: Vec3, n: Vec3, radius: f32) -> Shape {
-    Shape::Disk(Disk::new(Arc::new(frame_at(c, n)), false, 0.0, radius, 0.0, 360.0))
+    Shape::Disk(Disk::new(
+        Arc::new(frame_at(c, n)),
+        false,
+        0.0,
+        radius,
+        0.0,
+        360.0,
+    ))
 }
 
 /// The triangle `p` (normal (p1 − p0) × (p2 − p0)).
 fn triangle(p: [Vec3; 3]) -> Shape {
-    let mesh = TriangleMesh::new(&Transform::IDENTITY, false, vec![0, 1, 2], p.to_vec(), None, None, None);
+    let mesh = TriangleMesh::new(
+        &Transform::IDENTITY,
+        false,
+        vec![0, 1, 2],
+        p.to_vec(),
+        None,
+        None,
+        None,
+    );
     Shape::Triangle(Triangle::new(Arc::new(mesh.expect("valid triangle")), 0))
 }
 
@@ -65,16 +85,35 @@ fn many_lights(seed: u64) -> Vec<Light> {
                 Light::Spot(SpotLight::new(t, spectrum(l), 1.0, end, start))
             }
             2 => area(disk(c, dir(&mut r), 0.1 + 0.3 * r.uniform_f32()), l, false),
-            3 => area(triangle([c, c + 0.5 * u3(&mut r), c + 0.5 * u3(&mut r)]), l, false),
-            4 => area(triangle([c, c + 0.5 * u3(&mut r), c + 0.5 * u3(&mut r)]), l, true),
+            3 => area(
+                triangle([c, c + 0.5 * u3(&mut r), c + 0.5 * u3(&mut r)]),
+                l,
+                false,
+            ),
+            4 => area(
+                triangle([c, c + 0.5 * u3(&mut r), c + 0.5 * u3(&mut r)]),
+                l,
+                true,
+            ),
             5 => {
-                let s = Sphere::new(Arc::new(Transform::translate(c)), false, 0.2, -0.2, 0.2, 360.0);
+                let s = Sphere::new(
+                    Arc::new(Transform::translate(c)),
+                    false,
+                    0.2,
+                    -0.2,
+                    0.2,
+                    360.0,
+                );
                 area(Shape::Sphere(s), l, false)
             }
             _ => area(disk(c, dir(&mut r), 0.2), l, true),
         });
     }
-    lights.extend(crate::light::tests::power::lights_with_phi().into_iter().map(|(_, l, _)| l));
+    lights.extend(
+        crate::light::tests::power::lights_with_phi()
+            .into_iter()
+            .map(|(_, l, _)| l),
+    );
     lights
 }
 
@@ -82,7 +121,11 @@ fn many_lights(seed: u64) -> Vec<Light> {
 /// four) in free space (zero normal).
 fn receiver(r: &mut Pcg32) -> LightSampleContext {
     let p = 5.0 * u3(r);
-    let n = if r.uniform_f32() < 0.25 { Vec3::ZERO } else { dir(r) };
+    let n = if r.uniform_f32() < 0.25 {
+        Vec3::ZERO
+    } else {
+        dir(r)
+    };
     LightSampleContext {
         p,
         p_error: Vec3::ZERO,
@@ -127,7 +170,11 @@ fn every_trail_leads_to_its_light() {
                 assert!(lb.phi > 0.0);
                 let (mut i, mut t) = (0, *trail);
                 while !s.nodes[i].is_leaf() {
-                    i = if t & 1 == 0 { i + 1 } else { s.nodes[i].target() as usize };
+                    i = if t & 1 == 0 {
+                        i + 1
+                    } else {
+                        s.nodes[i].target() as usize
+                    };
                     t >>= 1;
                 }
                 assert_eq!(s.nodes[i].target() as usize, id);
@@ -164,7 +211,9 @@ fn sample_frequencies_match_the_pmf() {
                 None => counts[lights.len()] += 1,
             }
         }
-        let mut p: Vec<f64> = (0..lights.len()).map(|i| s.pmf(&ctx, LightId(i as u32)) as f64).collect();
+        let mut p: Vec<f64> = (0..lights.len())
+            .map(|i| s.pmf(&ctx, LightId(i as u32)) as f64)
+            .collect();
         p.push((1.0 - p.iter().sum::<f64>()).max(0.0));
         for (bin, (&c, &p)) in counts.iter().zip(&p).enumerate() {
             let (e, sigma) = (n as f64 * p, (n as f64 * p * (1.0 - p)).sqrt());
@@ -190,24 +239,32 @@ fn pmfs_sum_to_one_less_the_dead_ends() {
         let ctx = receiver(&mut r);
         let pmf = |i: usize| s.pmf(&ctx, LightId(i as u32)) as f64;
         let (mut tree, mut inf) = (0.0, 0.0);
-        for i in 0..lights.len() {
-            match lights[i].bounds() {
+        for (i, light) in lights.iter().enumerate() {
+            match light.bounds() {
                 Some(_) => tree += pmf(i),
                 None => inf += pmf(i),
             }
         }
         assert!((inf - p_inf).abs() <= 1e-6, "{inf} vs {p_inf}");
         let dead = dead_end_mass(&s, &ctx);
-        assert!((tree + dead - (1.0 - p_inf)).abs() <= 1e-5, "{tree} + {dead} at {ctx:?}");
+        assert!(
+            (tree + dead - (1.0 - p_inf)).abs() <= 1e-5,
+            "{tree} + {dead} at {ctx:?}"
+        );
     }
     let omni: Vec<Light> = lights
         .into_iter()
-        .filter(|l| matches!(l, Light::Point(_)) || matches!(l, Light::DiffuseArea(a) if matches!(a.shape(), Shape::Sphere(_))))
+        .filter(|l| {
+            matches!(l, Light::Point(_))
+                || matches!(l, Light::DiffuseArea(a) if matches!(a.shape(), Shape::Sphere(_)))
+        })
         .collect();
     let s = BvhLightSampler::new(&omni);
     for _ in 0..100 {
         let ctx = LightSampleContext::at_point(5.0 * u3(&mut r));
-        let sum: f64 = (0..omni.len()).map(|i| s.pmf(&ctx, LightId(i as u32)) as f64).sum();
+        let sum: f64 = (0..omni.len())
+            .map(|i| s.pmf(&ctx, LightId(i as u32)) as f64)
+            .sum();
         assert!((sum - 1.0).abs() <= 1e-5, "{sum}");
     }
 }
@@ -227,11 +284,16 @@ fn lights_that_reach_a_receiver_can_be_chosen() {
         for (i, light) in lights.iter().enumerate() {
             let lit = (0..8).any(|_| {
                 let u = Vec2::new(r.uniform_f32(), r.uniform_f32());
-                light.sample_li(&ctx, u, &lambda).is_some_and(|ls| !ls.l.is_black())
+                light
+                    .sample_li(&ctx, u, &lambda)
+                    .is_some_and(|ls| !ls.l.is_black())
             });
             if lit {
                 reached += 1;
-                assert!(s.pmf(&ctx, LightId(i as u32)) > 0.0, "light {i} reaches {ctx:?} with pmf 0");
+                assert!(
+                    s.pmf(&ctx, LightId(i as u32)) > 0.0,
+                    "light {i} reaches {ctx:?} with pmf 0"
+                );
             }
         }
     }
@@ -252,15 +314,25 @@ fn reference_importance(b: &LightBounds, p: Vec3, n: Vec3) -> (f64, f64, f64) {
     }
     let (c, radius) = b.bounds.bounding_sphere();
     let dc = (p.as_dvec3() - c.as_dvec3()).length();
-    let theta_b = if dc <= radius as f64 { std::f64::consts::PI } else { (radius as f64 / dc).asin() };
+    let theta_b = if dc <= radius as f64 {
+        std::f64::consts::PI
+    } else {
+        (radius as f64 / dc).asin()
+    };
     let theta_p = sub(sub(theta_w, (b.cos_theta_o as f64).acos()), theta_b);
     let mut imp = b.phi as f64 * theta_p.cos();
     if n != Vec3::ZERO {
         let theta_i = n.as_dvec3().normalize().dot(wi).abs().min(1.0).acos();
         imp *= sub(theta_i, theta_b).cos();
     }
-    let d2 = d.length_squared().max(b.bounds.diagonal().as_dvec3().length() / 2.0);
-    (theta_p.cos() - (b.cos_theta_e as f64), imp / d2, b.phi as f64 / d2)
+    let d2 = d
+        .length_squared()
+        .max(b.bounds.diagonal().as_dvec3().length() / 2.0);
+    (
+        theta_p.cos() - (b.cos_theta_e as f64),
+        imp / d2,
+        b.phi as f64 / d2,
+    )
 }
 
 #[test]
@@ -277,7 +349,11 @@ fn importance_is_zero_exactly_where_the_angle_bound_is() {
             r.uniform_f32() < 0.3,
         );
         let p = 3.0 * u3(&mut r);
-        let n = if r.uniform_f32() < 0.3 { Vec3::ZERO } else { dir(&mut r) };
+        let n = if r.uniform_f32() < 0.3 {
+            Vec3::ZERO
+        } else {
+            dir(&mut r)
+        };
         let (margin, expected, scale) = reference_importance(&lb, p, n);
         if margin.abs() < 1e-4 {
             continue; // At the boundary f32 round-off decides.
@@ -289,8 +365,14 @@ fn importance_is_zero_exactly_where_the_angle_bound_is() {
             assert_eq!(got, 0.0, "{lb:?} at {p:?}, n {n:?}");
         } else {
             // f32 sines and cosines of the angles: ~10⁻⁶ absolute on the cosines.
-            assert!((got - expected).abs() <= 1e-4 * scale, "{lb:?} at {p:?}: {got} vs {expected}");
+            assert!(
+                (got - expected).abs() <= 1e-4 * scale,
+                "{lb:?} at {p:?}: {got} vs {expected}"
+            );
         }
     }
-    assert!(zeros > 5_000 && checked - zeros > 5_000, "{zeros} of {checked}");
+    assert!(
+        zeros > 5_000 && checked - zeros > 5_000,
+        "{zeros} of {checked}"
+    );
 }
