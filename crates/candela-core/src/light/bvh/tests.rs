@@ -376,3 +376,30 @@ fn importance_is_zero_exactly_where_the_angle_bound_is() {
         "{zeros} of {checked}"
     );
 }
+
+/// Random cones and directions: anything in either cone is in the union.
+#[test]
+fn union_contains_both_cones() {
+    let mut rng = Pcg32::new(7, 0);
+    for _ in 0..2000 {
+        let cone = |rng: &mut Pcg32| {
+            let w = sample_uniform_sphere(Vec2::new(rng.uniform_f32(), rng.uniform_f32()));
+            DirectionCone::new(w, 2.0 * rng.uniform_f32() - 1.0)
+        };
+        let (a, b) = (cone(&mut rng), cone(&mut rng));
+        let u = a.union(b);
+        for _ in 0..20 {
+            let d = sample_uniform_sphere(Vec2::new(rng.uniform_f32(), rng.uniform_f32()));
+            // The f32 round-off of a dot product (a few ulps) is the slack.
+            let slack = 4.0 * f32::EPSILON;
+            for c in [a, b] {
+                if c.w.dot(d) >= c.cos_theta {
+                    assert!(
+                        u.w.dot(d) >= u.cos_theta - slack,
+                        "{a:?} ∪ {b:?} = {u:?} misses {d:?}"
+                    );
+                }
+            }
+        }
+    }
+}
