@@ -8,6 +8,7 @@
 #[path = "../benches/common/mod.rs"]
 mod common;
 
+use candela_core::light::LightSelection;
 use candela_core::scene::{Primitive, Scene};
 use candela_core::shape::{Shape, Triangle};
 use common::bvh_scene::{displaced_sphere, incoherent_rays};
@@ -44,7 +45,7 @@ fn main() {
     let mesh_time = t0.elapsed().as_secs_f64();
     let before = peak_rss();
     let t0 = Instant::now();
-    let scene = Scene::new(prims, Vec::new(), Vec::new(), false);
+    let scene = Scene::new(prims, Vec::new(), Vec::new(), LightSelection::Uniform);
     let build = t0.elapsed().as_secs_f64();
     let rays = incoherent_rays(&scene.bounds(), 1 << 16);
     let t0 = Instant::now();

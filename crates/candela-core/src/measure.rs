@@ -17,7 +17,8 @@
 //!   [pbrt-v4 §13.4]. Its depth limit is [`MeasureSettings::max_depth`];
 //! - **light sampling at the sensor** for the area and infinite lights
 //!   the cosine ray could hit directly: one light chosen by the scene's
-//!   light sampler (pmf P), a direction on it (density p_l), contributing
+//!   light sampler for next-event estimation, given the sensor's point and
+//!   normal (pmf P), a direction on it (density p_l), contributing
 //!   L·cos θ/(P·p_l) weighted by the power heuristic against the cosine
 //!   density, while the emission the cosine ray finds at its first hit
 //!   takes the complementary weight [Veach 1997, eq. 9.13]
@@ -36,7 +37,7 @@
 
 use crate::integrator::{PathIntegrator, PathSettings, RenderContext};
 use crate::interaction::Interaction;
-use crate::light::LightSampleContext;
+use crate::light::{LightChooser, LightSampleContext};
 use crate::math::{Frame, Ray, Vec3, PI};
 use crate::sampling::{power_heuristic, sample_cosine_hemisphere};
 pub(crate) use crate::spectrum::luminous;
@@ -135,8 +136,21 @@ pub(crate) fn illuminance_sample(
     e += light_irradiance(ctx, origin, n, &lambda, u_light, u);
     let wi = Frame::from_z(n).from_local(sample_cosine_hemisphere(sampler.get_2d()));
     let pdf = wi.dot(n).max(0.0) / PI;
-    e += path.li_sampled(ctx, Ray::new(origin, wi), pdf, &mut lambda, sampler) * PI;
+    let sensor = sensor_context(origin, n);
+    e += path.li_sampled(ctx, Ray::new(origin, wi), pdf, sensor, &mut lambda, sampler) * PI;
     luminous(&e, &lambda)
+}
+
+/// The light-sampling context of a sensor at `origin` facing `n`: the light
+/// sampler sees the sensor's normal (its cosine enters the BVH sampler's
+/// importance); no error bound, so the light's shapes spawn no offset.
+fn sensor_context(origin: Vec3, n: Vec3) -> LightSampleContext {
+    LightSampleContext {
+        p: origin,
+        p_error: Vec3::ZERO,
+        n,
+        ns: n,
+    }
 }
 
 /// One MIS-weighted light sample of the hittable (non-delta) lights'
@@ -150,7 +164,8 @@ fn light_irradiance(
     u: crate::math::Vec2,
 ) -> SampledSpectrum {
     let scene = ctx.scene;
-    let Some((id, pmf)) = scene.light_sampler().sample(u_light) else {
+    let lsc = sensor_context(origin, n);
+    let Some((id, pmf)) = scene.nee_light_sampler().choose(&lsc, u_light) else {
         return SampledSpectrum::zero();
     };
     let light = scene.light(id);
@@ -158,7 +173,6 @@ fn light_irradiance(
         // Counted, every sample, by `delta_irradiance`.
         return SampledSpectrum::zero();
     }
-    let lsc = LightSampleContext::at_point(origin);
     let Some(ls) = light.sample_li(&lsc, u, lambda) else {
         return SampledSpectrum::zero();
     };

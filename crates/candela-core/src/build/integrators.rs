@@ -18,6 +18,7 @@ use crate::integrator::{
     PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator,
     PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator, VcmMode, VcmSettings, Visualize,
 };
+use crate::light::LightSelection;
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription};
 
 /// The settings of each integrator, read and checked.
@@ -42,8 +43,9 @@ pub struct Planned<'a> {
     what: String,
     /// `"float radius"` as written (SPPM and PPM).
     radius: Option<f32>,
-    /// Lights are chosen in proportion to power (else uniformly).
-    pub power_sampling: bool,
+    /// The light samplers (`"string lightsampler"`; the photon estimators'
+    /// `"uniform"` becomes `"power"`).
+    pub light_selection: LightSelection,
     /// BDPT strategy layers the film must record (0 without visualisation).
     pub strategy_layers: usize,
     /// `"integer maxdepth"` (every integrator reads it; pbrt-v4's default 5).
@@ -118,7 +120,7 @@ pub fn integrator<'a>(
         )
     };
     let ck = Check::new(p, &e.loc, &what);
-    let power_sampling = light_sampler(p, &e.loc)?;
+    let selection = light_sampler(p, &e.loc)?;
     let seed = render_seed(desc, ov)?;
     let common = Common {
         max_depth: ck.int("maxdepth", 5, 0)? as u32,
@@ -126,7 +128,7 @@ pub fn integrator<'a>(
         seed,
         flag_seed: ov.seed,
     };
-    let (settings, strategy_layers) = construct(kind, &ck, &common, power_sampling, warnings)?;
+    let (settings, strategy_layers) = construct(kind, &ck, &common, selection, warnings)?;
     let radius = match kind {
         IntegratorKind::Sppm | IntegratorKind::Ppm | IntegratorKind::Vcm => {
             ck.float_opt("radius", Domain::Positive)?
@@ -134,21 +136,24 @@ pub fn integrator<'a>(
         _ => None,
     };
     // Photons are shot by power, as pbrt-v4's SPPM does.
-    let power_sampling = power_sampling
-        || matches!(
-            kind,
-            IntegratorKind::Sppm
-                | IntegratorKind::Ppm
-                | IntegratorKind::PhotonMap
-                | IntegratorKind::Vcm
-        );
+    let photons = matches!(
+        kind,
+        IntegratorKind::Sppm
+            | IntegratorKind::Ppm
+            | IntegratorKind::PhotonMap
+            | IntegratorKind::Vcm
+    );
+    let light_selection = match selection {
+        LightSelection::Uniform if photons => LightSelection::Power,
+        s => s,
+    };
     Ok(Planned {
         kind,
         settings,
         entity: e,
         what,
         radius,
-        power_sampling,
+        light_selection,
         strategy_layers,
         max_depth: common.max_depth,
     })
@@ -242,7 +247,7 @@ fn construct(
     kind: IntegratorKind,
     ck: &Check<'_>,
     common: &Common,
-    power_sampling: bool,
+    selection: LightSelection,
     warnings: &mut Vec<String>,
 ) -> Result<(Settings, usize), BuildError> {
     Ok(match kind {
@@ -266,7 +271,7 @@ fn construct(
         IntegratorKind::Ppm => (Settings::Ppm(ppm_settings(ck, common)?), 0),
         IntegratorKind::Vcm => (Settings::Vcm(vcm_settings(ck, common)?), 0),
         IntegratorKind::PhotonMap => {
-            if !power_sampling {
+            if selection == LightSelection::Uniform {
                 warnings.push(format!(
                     "{}: \"photonmap\" always chooses lights by power; \"lightsampler\" is ignored",
                     ck.loc
@@ -287,11 +292,12 @@ struct Common {
     flag_seed: Option<u64>,
 }
 
-/// `"string lightsampler"`: true for power-proportional selection.
-fn light_sampler(p: &ParamSet, loc: &Loc) -> Result<bool, BuildError> {
+/// `"string lightsampler"` (pbrt-v4's default `"bvh"`).
+fn light_sampler(p: &ParamSet, loc: &Loc) -> Result<LightSelection, BuildError> {
     match p.get_string("lightsampler", "bvh")?.as_str() {
-        "uniform" => Ok(false),
-        "power" | "bvh" => Ok(true),
+        "uniform" => Ok(LightSelection::Uniform),
+        "power" => Ok(LightSelection::Power),
+        "bvh" => Ok(LightSelection::Bvh),
         other => Err(BuildError::at(
             p.param_loc("lightsampler").unwrap_or(loc),
             format!("unknown light sampler \"{other}\" (known: uniform, power, bvh)"),

@@ -158,8 +158,8 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .collect();
     lights.extend(lights::lights(desc, &mut warnings)?);
     let shutter = entities::shutter(desc)?;
-    let power_sampling = plan.power_sampling;
-    let mut scene = Scene::with_motion(prims, movers, shutter, materials, lights, power_sampling);
+    let selection = plan.light_selection;
+    let mut scene = Scene::with_motion(prims, movers, shutter, materials, lights, selection);
     // Only textures read the differentials (filter widths, bump steps), and
     // every non-constant texture is a `Texture` directive: without any, the
     // per-hit footprint would cost time (several per cent on the Cornell box)

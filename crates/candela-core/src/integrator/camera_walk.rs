@@ -74,7 +74,9 @@ where
             return Flow::Continue;
         }
         if let Some(r) = Receiver::at_vertex(v) {
-            if let Some(ls) = sample_light(self.scene, &r, lambda, rng) {
+            if let Some(ls) =
+                sample_light(self.scene, self.scene.nee_light_sampler(), &r, lambda, rng)
+            {
                 self.l += v.beta * ls.unweighted();
             }
         }

@@ -2,7 +2,9 @@
 //! every estimator that connects a camera-side vertex to a light [Veach
 //! 1997, §10.2, s = 1; pbrt-v4 `PathIntegrator::SampleLd`].
 //!
-//! A light is chosen by the scene's light sampler (pmf p_light), a point or
+//! A light is chosen by the caller's light sampler for the receiving point
+//! (pmf p_light: the scene's NEE sampler for the path tracer and the photon
+//! estimators, its context-free one for BDPT and VCM), a point or
 //! direction on it by the light itself (density p(ω) per unit solid angle at
 //! the receiver, 1 for delta lights), and the record holds what each caller
 //! needs: f·|cos θ| at the receiver, Li, both densities with their measure,
@@ -24,7 +26,7 @@
 use super::subpath::Vertex;
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::interaction::{Interaction, LightId, SurfaceInteraction};
-use crate::light::{LightSampleContext, LightType};
+use crate::light::{LightChooser, LightSampleContext, LightType};
 use crate::math::Vec3;
 use crate::sampling::{power_heuristic, PathRng, PdfSolidAngle};
 use crate::scene::Scene;
@@ -84,10 +86,12 @@ pub struct LightSample {
     pub p_light: Interaction,
 }
 
-/// Samples one light for `r` and tests visibility; `None` when the receiver
-/// has no non-specular lobe or the sample carries nothing.
-pub fn sample_light<R: PathRng + ?Sized>(
+/// Samples one light for `r`, chosen by `chooser`, and tests visibility;
+/// `None` when the receiver has no non-specular lobe or the sample carries
+/// nothing.
+pub fn sample_light<R: PathRng + ?Sized, C: LightChooser + ?Sized>(
     scene: &Scene,
+    chooser: &C,
     r: &Receiver<'_>,
     lambda: &SampledWavelengths,
     rng: &mut R,
@@ -96,13 +100,13 @@ pub fn sample_light<R: PathRng + ?Sized>(
     if !r.bsdf.flags().is_non_specular() {
         return None;
     }
-    let (light, pmf) = scene.light_sampler().sample(u_light)?;
     let ctx = LightSampleContext {
         p: r.it.p,
         p_error: r.it.p_error,
         n: r.it.n,
         ns: r.ns,
     };
+    let (light, pmf) = chooser.choose(&ctx, u_light)?;
     let ls = scene.light(light).sample_li(&ctx, u, lambda)?;
     if ls.l.is_black() || ls.pdf.0 == 0.0 {
         return None;

@@ -25,7 +25,7 @@ use super::{
 use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
 use crate::film::{PassBlock, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
-use crate::light::LightSampleContext;
+use crate::light::{LightChooser, LightSampleContext};
 use crate::math::{Ray, Vec3};
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
@@ -105,14 +105,16 @@ impl PixelEstimator for PathIntegrator {
         sampler: &mut Sampler,
         _splats: &mut SplatBuffer,
     ) -> SampledSpectrum {
-        self.trace(ctx, ray, PathState::start(ray.o, None), lambda, sampler)
+        let start = PathState::start(LightSampleContext::at_point(ray.o), None);
+        self.trace(ctx, ray, start, lambda, sampler)
     }
 }
 
 impl PathState {
-    /// The state before the first vertex of a path leaving `o`, along a
-    /// direction of solid-angle density `pdf` (`None`: a camera ray).
-    fn start(o: Vec3, pdf: Option<f32>) -> Self {
+    /// The state before the first vertex of a path leaving the point of
+    /// `from`, along a direction of solid-angle density `pdf` (`None`: a
+    /// camera ray).
+    fn start(from: LightSampleContext, pdf: Option<f32>) -> Self {
         Self {
             l: SampledSpectrum::zero(),
             beta: SampledSpectrum::one(),
@@ -120,7 +122,7 @@ impl PathState {
             specular_bounce: false,
             any_non_specular: false,
             prev_pdf: pdf.unwrap_or(0.0),
-            prev_ctx: LightSampleContext::at_point(o),
+            prev_ctx: from,
             eta_scale: 1.0,
             unweighted_start: pdf.is_none(),
         }
@@ -132,22 +134,19 @@ impl PathIntegrator {
     /// direction was sampled with solid-angle density `pdf` (`candela
     /// measure`): as [`PixelEstimator::li`], but emission found at the
     /// first hit is MIS-weighted (power heuristic) against a light sample
-    /// taken at the sensor from `LightSampleContext::at_point(ray.o)`.
+    /// taken at the sensor `sensor` (whose point is `ray.o`).
     pub(crate) fn li_sampled(
         &self,
         ctx: &RenderContext<'_>,
         ray: Ray,
         pdf: f32,
+        sensor: LightSampleContext,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
     ) -> SampledSpectrum {
-        self.trace(
-            ctx,
-            ray,
-            PathState::start(ray.o, Some(pdf)),
-            lambda,
-            sampler,
-        )
+        debug_assert_eq!(sensor.p, ray.o);
+        let start = PathState::start(sensor, Some(pdf));
+        self.trace(ctx, ray, start, lambda, sampler)
     }
 
     /// The path loop from state `st`.
@@ -182,7 +181,9 @@ impl PathIntegrator {
             let wo = -ray.d.normalize();
             if bsdf.flags().is_non_specular() {
                 let r = Receiver::at_hit(&si, &bsdf, wo);
-                if let Some(ls) = sample_light(scene, &r, lambda, sampler) {
+                if let Some(ls) =
+                    sample_light(scene, scene.nee_light_sampler(), &r, lambda, sampler)
+                {
                     st.l += st.beta * ls.bsdf_mis_weighted(scene, &r);
                 }
             }
@@ -221,8 +222,8 @@ impl PathIntegrator {
             if (st.depth == 0 && st.unweighted_start) || st.specular_bounce {
                 st.l += st.beta * le;
             } else {
-                let p_light =
-                    scene.light_sampler().pmf(id) * light.pdf_li(&st.prev_ctx, ray.d.normalize()).0;
+                let pmf = scene.nee_light_sampler().choose_pmf(&st.prev_ctx, id);
+                let p_light = pmf * light.pdf_li(&st.prev_ctx, ray.d.normalize()).0;
                 st.l += st.beta * le * power_heuristic(1.0, st.prev_pdf, 1.0, p_light);
             }
         }
@@ -245,7 +246,8 @@ impl PathIntegrator {
         if (st.depth == 0 && st.unweighted_start) || st.specular_bounce {
             st.l += st.beta * le;
         } else {
-            let p_light = scene.light_sampler().pmf(id) * light.pdf_li(&st.prev_ctx, -si.wo).0;
+            let pmf = scene.nee_light_sampler().choose_pmf(&st.prev_ctx, id);
+            let p_light = pmf * light.pdf_li(&st.prev_ctx, -si.wo).0;
             st.l += st.beta * le * power_heuristic(1.0, st.prev_pdf, 1.0, p_light);
         }
     }

@@ -46,6 +46,7 @@
 //! strategies then disagree, and only 0/1 alpha is consistent. Φ ignores
 //! alpha, as pbrt-v4's does.
 
+use super::bounds::{scalar, LightBounds};
 use super::{LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::image::{MapImage, WrapMode};
 use crate::interaction::Interaction;
@@ -341,5 +342,19 @@ impl DiffuseAreaLight {
             }
         };
         l * (sides * self.scale * self.area * PI)
+    }
+
+    /// Emission bounds [pbrt-v4 `DiffuseAreaLight::Bounds`]: the shape's box
+    /// and normal cone, Lambertian spread π/2, power π·A·L of one side.
+    pub(super) fn bounds(&self) -> LightBounds {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        let phi = scalar(|l| self.phi(l)) / sides;
+        LightBounds::new(
+            self.shape.bounds(),
+            self.shape.normal_bounds(),
+            phi,
+            0.0,
+            self.two_sided,
+        )
     }
 }

@@ -23,6 +23,7 @@
 //! light frame (nadir +z, horizontal angle 0 +x), emission sampling is the
 //! web's own ∝ I(ω), and Φ = scale·I_e·∫I dω with the web's exact flux.
 
+use super::bounds::{isotropic_point, scalar, LightBounds};
 use super::{
     delta_position_li, IesWeb, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum,
 };
@@ -190,5 +191,11 @@ impl GoniometricLight {
     /// Φ = scale·I_e·∫Y dω (4π·mean(Y) for a map, the web's flux for IES).
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         self.i.sample(lambda) * (self.scale * self.pattern_integral())
+    }
+
+    /// Emission bounds: bounded as an isotropic point light of the same
+    /// power Φ, as pbrt-v4 does (the map may light any direction).
+    pub(super) fn bounds(&self) -> LightBounds {
+        isotropic_point(self.position(), scalar(|l| self.phi(l)))
     }
 }

@@ -33,6 +33,8 @@
 //! ([`Light::preprocess`]) before `phi`, `sample_li` (for the far point) and
 //! `sample_le` (which aims rays from a disk of the scene's radius) are valid.
 
+mod bounds;
+mod bvh;
 mod create;
 mod diffuse_area;
 mod distant;
@@ -50,6 +52,8 @@ mod spot;
 #[cfg(test)]
 mod tests;
 
+pub use bounds::LightBounds;
+pub use bvh::BvhLightSampler;
 pub use create::{
     diffuse_area_image_light, diffuse_area_light, distant_light, goniometric_light, ies_light,
     image_infinite_light, point_light, projection_light, spot_light, uniform_infinite_light,
@@ -64,7 +68,7 @@ pub use image_infinite::ImageInfiniteLight;
 pub use infinite::UniformInfiniteLight;
 pub use point::PointLight;
 pub use projection::ProjectionLight;
-pub use sampler::LightSampler;
+pub use sampler::{LightChooser, LightSampler, LightSelection, NeeLightSampler};
 pub use spot::SpotLight;
 
 use crate::interaction::{Interaction, SurfaceInteraction};

@@ -6,6 +6,7 @@
 //! sampling draws a uniform direction on the sphere, p_dir = 1/(4π), so
 //! `β₀ = I/(1/(4π)) = Φ` exactly.
 
+use super::bounds::{isotropic_point, scalar, LightBounds};
 use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
 use crate::math::{Ray, Transform, Vec2, Vec3, PI};
 use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf, PdfArea, PdfSolidAngle};
@@ -77,5 +78,10 @@ impl PointLight {
     /// Φ = 4π·I (seed eq. 二.5).
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         self.intensity(lambda) * (4.0 * PI)
+    }
+
+    /// Emission bounds: the point, every direction, power Φ = 4πI.
+    pub(super) fn bounds(&self) -> LightBounds {
+        isotropic_point(self.position(), scalar(|l| self.phi(l)))
     }
 }

@@ -38,9 +38,10 @@
 //! pbrt-v4's p_dir = p_screen/(t²·cos³θ) with its piecewise-constant screen
 //! density is replaced by the exact one.
 
+use super::bounds::{isotropic_point, preserves_angles, scalar, LightBounds};
 use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext};
 use crate::image::MapImage;
-use crate::math::{Ray, Transform, Vec2, Vec3};
+use crate::math::{Bounds3, DirectionCone, Ray, Transform, Vec2, Vec3};
 use crate::sampling::{Distribution2D, PdfArea, PdfSolidAngle};
 use crate::spectrum::{
     ColorSpace, Rgb, SampledSpectrum, SampledWavelengths, SpectrumKind, N_SPECTRUM_SAMPLES,
@@ -271,6 +272,29 @@ impl ProjectionLight {
             }
         }
         SampledSpectrum::from_fn(|k| sum[k] as f32)
+    }
+
+    /// Emission bounds [pbrt-v4 `ProjectionLight::Bounds`]: the axis, with
+    /// emission reaching the frustum's corner direction; power 4π times the
+    /// mean intensity over the frustum (Φ/Ω). A light frame that distorts
+    /// angles gets the isotropic bound.
+    pub(super) fn bounds(&self) -> LightBounds {
+        let p = self.position();
+        let omega: f64 = self.omega.iter().map(|&o| o as f64).sum();
+        let phi = if omega > 0.0 {
+            scalar(|l| self.phi(l)) * (4.0 * std::f64::consts::PI / omega) as f32
+        } else {
+            0.0
+        };
+        if !preserves_angles(&self.render_from_light) {
+            return isotropic_point(p, phi);
+        }
+        let [x0, y0, x1, y1] = self.window;
+        let t = self.tan_half_fov;
+        let corner = Vec3::new(x0.abs().max(x1.abs()) * t, y0.abs().max(y1.abs()) * t, 1.0);
+        let cos_e = corner.normalize().z;
+        let cone = DirectionCone::from_direction(self.render_from_light.vector(Vec3::Z));
+        LightBounds::new(Bounds3::from_point(p), cone, phi, cos_e, false)
     }
 }
 

@@ -14,8 +14,12 @@
 //! uniformly or the band proportionally to the smoothstep; p_dir is therefore
 //! exactly proportional to I(ω), and `β₀ = Φ` for every sample.
 
+use super::bounds::{isotropic_point, preserves_angles, scalar, LightBounds};
 use super::{delta_position_li, LightLeSample, LightLiSample, LightSampleContext, LightSpectrum};
-use crate::math::{safe_sqrt, spherical_direction, Ray, Transform, Vec2, Vec3, PI};
+use crate::math::{
+    next_float_down, safe_sqrt, spherical_direction, Bounds3, DirectionCone, Ray, Transform, Vec2,
+    Vec3, PI,
+};
 use crate::sampling::{sample_uniform_cone, uniform_cone_pdf, PdfArea, PdfSolidAngle};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -184,6 +188,25 @@ impl SpotLight {
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         let p = self.section_weights();
         self.i.sample(lambda) * (self.scale * 2.0 * PI * (p[0] + p[1]))
+    }
+
+    /// Emission bounds [pbrt-v4 `SpotLight::Bounds`]: normals within θ_start
+    /// of the axis, spreading θ_end − θ_start further, power 4π·I₀. With no
+    /// falloff band (θ_end = θ_start) the spread is the smallest angle above
+    /// zero, so that the cone's own directions (θ' = 0) keep their
+    /// importance. A light frame that distorts angles gets the isotropic bound.
+    pub(super) fn bounds(&self) -> LightBounds {
+        let p = self.position();
+        let phi = scalar(|l| self.i.sample(l) * (self.scale * 4.0 * PI));
+        if !preserves_angles(&self.render_from_light) {
+            return isotropic_point(p, phi);
+        }
+        let w = self.render_from_light.vector(Vec3::Z);
+        let theta_e = self.cos_falloff_end.clamp(-1.0, 1.0).acos()
+            - self.cos_falloff_start.clamp(-1.0, 1.0).acos();
+        let cos_e = theta_e.max(0.0).cos().min(next_float_down(1.0));
+        let cone = DirectionCone::new(w, self.cos_falloff_start);
+        LightBounds::new(Bounds3::from_point(p), cone, phi, cos_e, false)
     }
 }
 

@@ -21,16 +21,33 @@ pub use warp::*;
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Power heuristic with β = 2 for `nf` samples of density `f_pdf` against
-/// `ng` of `g_pdf` [Veach 1997, eq. 9.13].
+/// `ng` of `g_pdf` [Veach 1997, eq. 9.13]. The squares are taken in f64:
+/// in f32 a density above ~1.8·10¹⁹ (a light sampled at grazing angle from
+/// a point in its own plane) squares to ∞ and the weight to ∞/∞ = NaN.
 #[inline]
 pub fn power_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
-    let f = nf * f_pdf;
-    let g = ng * g_pdf;
+    let f = nf as f64 * f_pdf as f64;
+    let g = ng as f64 * g_pdf as f64;
     if f.is_infinite() {
         return 1.0;
     }
     if f == 0.0 && g == 0.0 {
         return 0.0;
     }
-    (f * f) / (f * f + g * g)
+    ((f * f) / (f * f + g * g)) as f32
+}
+
+#[cfg(test)]
+mod heuristic_tests {
+    use super::power_heuristic;
+
+    #[test]
+    fn power_heuristic_survives_huge_densities() {
+        assert_eq!(power_heuristic(1.0, 3.8e19, 1.0, 0.3), 1.0);
+        assert!(power_heuristic(1.0, 0.3, 1.0, 3.8e19) < 1e-38);
+        let w = power_heuristic(1.0, 3e19, 1.0, 4e19);
+        assert!((w - 9.0 / 25.0).abs() < 1e-6, "{w}");
+        assert_eq!(power_heuristic(1.0, f32::INFINITY, 1.0, 1.0), 1.0);
+        assert_eq!(power_heuristic(1.0, 0.0, 1.0, 0.0), 0.0);
+    }
 }

@@ -13,7 +13,7 @@ use crate::accel::{Bvh, BvhHit};
 use crate::bsdf::Bsdf;
 use crate::camera::PixelFootprint;
 use crate::interaction::{Interaction, LightId, SurfaceInteraction};
-use crate::light::{Light, LightSampler};
+use crate::light::{Light, LightSampler, LightSelection, NeeLightSampler};
 use crate::material::{mix_choice, Material};
 use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
 use crate::shape::{DeferredHit, WatertightRay};
@@ -31,7 +31,10 @@ pub struct Scene {
     materials: Vec<Material>,
     lights: Vec<Light>,
     infinite_lights: Vec<LightId>,
+    /// Context-free selection: light subpaths, BDPT and VCM.
     light_sampler: LightSampler,
+    /// Selection for next-event estimation at a receiver.
+    nee_sampler: NeeLightSampler,
     bounds: Bounds3,
     /// The camera's pixel footprint, for texture filtering (none: zero
     /// differentials).
@@ -44,7 +47,7 @@ impl Scene {
         primitives: Vec<Primitive>,
         materials: Vec<Material>,
         lights: Vec<Light>,
-        power_sampling: bool,
+        selection: LightSelection,
     ) -> Self {
         Self::with_motion(
             primitives,
@@ -52,7 +55,7 @@ impl Scene {
             (0.0, 1.0),
             materials,
             lights,
-            power_sampling,
+            selection,
         )
     }
 
@@ -64,7 +67,7 @@ impl Scene {
         shutter: (f32, f32),
         materials: Vec<Material>,
         mut lights: Vec<Light>,
-        power_sampling: bool,
+        selection: LightSelection,
     ) -> Self {
         let mover_bounds: Vec<Bounds3> = movers.iter().map(|m| m.bounds()).collect();
         let bvh = Primitive::bvh(&primitives, &mover_bounds);
@@ -76,11 +79,8 @@ impl Scene {
             .filter(|&i| matches!(lights[i].light_type(), crate::light::LightType::Infinite))
             .map(|i| LightId(i as u32))
             .collect();
-        let light_sampler = if power_sampling {
-            LightSampler::power(&lights)
-        } else {
-            LightSampler::uniform(&lights)
-        };
+        let light_sampler = selection.context_free(&lights);
+        let nee_sampler = selection.nee(&lights, &light_sampler);
         Self {
             primitives,
             shutter: (!movers.is_empty()).then_some(shutter),
@@ -90,6 +90,7 @@ impl Scene {
             lights,
             infinite_lights,
             light_sampler,
+            nee_sampler,
             bounds,
             footprint: None,
         }
@@ -151,9 +152,15 @@ impl Scene {
     pub fn infinite_lights(&self) -> &[LightId] {
         &self.infinite_lights
     }
-    /// The light-selection distribution.
+    /// The context-free light selection: light subpaths, and BDPT's and
+    /// VCM's light sampling at camera vertices.
     pub fn light_sampler(&self) -> &LightSampler {
         &self.light_sampler
+    }
+    /// The light selection of next-event estimation (path tracer, photon
+    /// estimators' camera side, `candela measure`).
+    pub fn nee_light_sampler(&self) -> &NeeLightSampler {
+        &self.nee_sampler
     }
     /// All materials.
     pub fn materials(&self) -> &[Material] {

@@ -78,7 +78,7 @@ fn scene_intersection_matches_brute_force() {
         (0.0, 1.0),
         vec![],
         vec![],
-        false,
+        crate::light::LightSelection::Uniform,
     );
     let mut r = Pcg32::new(9, 9);
     let mut hits = 0;

@@ -99,7 +99,7 @@ impl Disk {
     }
 
     /// Render-space normal: object +z, negated when reversed.
-    fn normal(&self) -> Vec3 {
+    pub(super) fn normal(&self) -> Vec3 {
         let n = self.render_from_object.normal(Vec3::Z).normalize_or_zero();
         if self.reverse_orientation {
             -n

@@ -30,6 +30,7 @@ mod disk;
 mod interval;
 mod loop_subdiv;
 mod mesh;
+mod normal_bounds;
 mod sphere;
 mod triangle;
 

@@ -205,7 +205,7 @@ fn connect_light<'a>(
 ) -> Option<(Unweighted, PathView<'a>)> {
     let v = &cam[t - 1];
     let r = Receiver::at_vertex(v)?;
-    let ls = sample_light(cx.scene, &r, cx.lambda, sampler)?;
+    let ls = sample_light(cx.scene, cx.scene.light_sampler(), &r, cx.lambda, sampler)?;
     let c = v.beta * ls.f_cos * ls.li / (ls.pmf * ls.pdf.0);
     if c.is_black() {
         return None;

@@ -269,7 +269,7 @@ impl CameraVisitor<'_, '_> {
         let Some(r) = Receiver::at_vertex(v) else {
             return;
         };
-        let Some(ls) = sample_light(scene, &r, lambda, rng) else {
+        let Some(ls) = sample_light(scene, scene.light_sampler(), &r, lambda, rng) else {
             return;
         };
         let light = scene.light(ls.light);

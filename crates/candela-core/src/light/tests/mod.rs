@@ -10,7 +10,7 @@ mod chi2;
 mod fixtures;
 mod image_infinite;
 mod irradiance;
-mod power;
+pub(super) mod power;
 mod punctual_maps;
 
 use super::*;

@@ -33,7 +33,7 @@ fn areas(geo: Geo, l: f32, two_sided: bool) -> Vec<Light> {
 }
 
 /// One light of every type and shape, with its closed-form Φ.
-fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
+pub(crate) fn lights_with_phi() -> Vec<(&'static str, Light, f64)> {
     let mut v = punctual_lights_with_phi();
     v.extend(area_lights_with_phi());
     v
