@@ -136,53 +136,93 @@ fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
     }
 }
 
-/// sin θb and cos θb of the cone `p` sees the bounding sphere of `bounds`
-/// under (θb = π inside it). The sine is computed directly as r/d: from the
-/// cosine it would vanish in f32 below θb ≈ 3·10⁻⁴ (cos θb rounds to 1),
-/// and the bound would lose the light's extent.
-#[inline]
-fn subtended_sin_cos(bounds: &Bounds3, p: Vec3) -> (f32, f32) {
-    let (center, radius) = bounds.bounding_sphere();
-    let d2 = p.distance_squared(center);
-    if d2 <= radius * radius {
-        return (0.0, -1.0);
-    }
-    let sin2 = radius * radius / d2;
-    (sin2.sqrt(), safe_sqrt(1.0 - sin2))
-}
-
 /// The importance of `b` at `p` with normal `n`; finite and ≥ 0.
 pub(crate) fn importance(b: &LightBounds, p: Vec3, n: Vec3) -> f32 {
-    let pc = b.bounds.centroid();
-    let d2 = p
-        .distance_squared(pc)
-        .max(b.bounds.diagonal().length() / 2.0);
-    let wi = (p - pc).normalize_or_zero();
-    let mut cos_w = b.w.dot(wi);
-    if b.two_sided {
-        cos_w = cos_w.abs();
+    PreparedBounds::new(b).importance(p, n)
+}
+
+/// Light bounds with what [`importance`] derives from them alone computed
+/// once (box centre, bounding sphere, half diagonal, sin θo), for the BVH
+/// light sampler, which evaluates each node's importance many times.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct PreparedBounds {
+    /// Box centre.
+    pc: Vec3,
+    /// Bounding sphere (centre, radius²).
+    sphere: (Vec3, f32),
+    /// |diagonal| / 2 (pbrt-v4's lower bound of d²).
+    half_diagonal: f32,
+    w: Vec3,
+    phi: f32,
+    cos_o: f32,
+    sin_o: f32,
+    cos_e: f32,
+    two_sided: bool,
+}
+
+impl PreparedBounds {
+    /// The prepared form of `b`.
+    pub fn new(b: &LightBounds) -> Self {
+        let (c, r) = b.bounds.bounding_sphere();
+        Self {
+            pc: b.bounds.centroid(),
+            sphere: (c, r * r),
+            half_diagonal: b.bounds.diagonal().length() / 2.0,
+            w: b.w,
+            phi: b.phi,
+            cos_o: b.cos_theta_o,
+            sin_o: safe_sqrt(1.0 - b.cos_theta_o * b.cos_theta_o),
+            cos_e: b.cos_theta_e,
+            two_sided: b.two_sided,
+        }
     }
-    let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
-    let (sin_b, cos_b) = subtended_sin_cos(&b.bounds, p);
-    // θx = θw ⊖ θo, then θ' = θx ⊖ θb.
-    let sin_o = safe_sqrt(1.0 - b.cos_theta_o * b.cos_theta_o);
-    let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, b.cos_theta_o);
-    let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, b.cos_theta_o);
-    let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-    if cos_p <= b.cos_theta_e {
-        return 0.0;
+
+    /// sin θb and cos θb of the cone `p` sees the bounding sphere under
+    /// (θb = π inside it). The sine is computed directly as r/d: from the
+    /// cosine it would vanish in f32 below θb ≈ 3·10⁻⁴ (cos θb rounds to 1),
+    /// and the bound would lose the light's extent.
+    #[inline]
+    fn subtended_sin_cos(&self, p: Vec3) -> (f32, f32) {
+        let (center, r2) = self.sphere;
+        let d2 = p.distance_squared(center);
+        if d2 <= r2 {
+            return (0.0, -1.0);
+        }
+        let sin2 = r2 / d2;
+        (sin2.sqrt(), safe_sqrt(1.0 - sin2))
     }
-    let mut imp = b.phi * cos_p;
-    if n != Vec3::ZERO {
-        let cos_i = wi.dot(n).abs();
-        let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
-        imp *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+
+    /// The importance at `p` with normal `n` (module doc); finite and ≥ 0.
+    #[inline]
+    pub fn importance(&self, p: Vec3, n: Vec3) -> f32 {
+        let pc = self.pc;
+        let d2 = p.distance_squared(pc).max(self.half_diagonal);
+        let wi = (p - pc).normalize_or_zero();
+        let mut cos_w = self.w.dot(wi);
+        if self.two_sided {
+            cos_w = cos_w.abs();
+        }
+        let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
+        let (sin_b, cos_b) = self.subtended_sin_cos(p);
+        // θx = θw ⊖ θo, then θ' = θx ⊖ θb.
+        let cos_x = cos_sub_clamped(sin_w, cos_w, self.sin_o, self.cos_o);
+        let sin_x = sin_sub_clamped(sin_w, cos_w, self.sin_o, self.cos_o);
+        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        if cos_p <= self.cos_e {
+            return 0.0;
+        }
+        let mut imp = self.phi * cos_p;
+        if n != Vec3::ZERO {
+            let cos_i = wi.dot(n).abs();
+            let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
+            imp *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+        }
+        if d2 == 0.0 {
+            // p at a point light: the bound is unbounded; keep it finite.
+            return if imp > 0.0 { f32::MAX } else { 0.0 };
+        }
+        (imp / d2).clamp(0.0, f32::MAX)
     }
-    if d2 == 0.0 {
-        // p at a point light: the bound is unbounded; keep it finite.
-        return if imp > 0.0 { f32::MAX } else { 0.0 };
-    }
-    (imp / d2).clamp(0.0, f32::MAX)
 }
 
 /// The scalar of a spectral quantity the light samplers rank lights by:

@@ -56,6 +56,7 @@ impl Builder<'_> {
             self.nodes.push(LightBvhNode::leaf(
                 *light,
                 CompactLightBounds::new(lb, &self.all),
+                &self.all,
             ));
             return *lb;
         }
@@ -67,7 +68,8 @@ impl Builder<'_> {
         let second = self.nodes.len() as u32;
         let b1 = self.node(right, trail | (1u64 << depth), depth + 1);
         let lb = b0.union(&b1);
-        self.nodes[index] = LightBvhNode::interior(second, CompactLightBounds::new(&lb, &self.all));
+        self.nodes[index] =
+            LightBvhNode::interior(second, CompactLightBounds::new(&lb, &self.all), &self.all);
         lb
     }
 }

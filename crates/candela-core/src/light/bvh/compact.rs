@@ -84,12 +84,6 @@ impl CompactLightBounds {
             two_sided: self.packed & (1 << 30) != 0,
         }
     }
-
-    /// Importance at `p` with normal `n` ([`LightBounds::importance`]).
-    #[inline]
-    pub fn importance(&self, p: Vec3, n: Vec3, all: &Bounds3) -> f32 {
-        self.decode(all).importance(p, n)
-    }
 }
 
 /// The 15-bit code of cos θ: the largest whose decoded value is ≤ c.

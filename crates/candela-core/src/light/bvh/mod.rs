@@ -37,18 +37,22 @@ mod compact;
 #[cfg(test)]
 mod tests;
 
+use super::bounds::PreparedBounds;
 use super::{Light, LightSampleContext};
 use crate::interaction::LightId;
 use crate::math::{Bounds3, Vec3};
 use crate::sampling::ONE_MINUS_EPSILON;
 use compact::CompactLightBounds;
 
-/// A node: packed bounds, and the second child's index (interior) or the
-/// light's index (leaf). 32 bytes, two per cache line.
+/// A node: its bounds, decoded from their packed form (so importances
+/// are those of pbrt-v4's compact bounds) and prepared for [`importance`]
+/// once rather than at every evaluation, and the second child's index
+/// (interior) or the light's index (leaf).
+///
+/// [`importance`]: super::bounds::PreparedBounds::importance
 #[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(32))]
 pub(crate) struct LightBvhNode {
-    bounds: CompactLightBounds,
+    bounds: PreparedBounds,
     /// Bit 31: leaf. Bits 0–30: light (leaf) or second child (interior).
     index: u32,
 }
@@ -56,17 +60,17 @@ pub(crate) struct LightBvhNode {
 const LEAF: u32 = 1 << 31;
 
 impl LightBvhNode {
-    fn leaf(light: u32, bounds: CompactLightBounds) -> Self {
+    fn leaf(light: u32, bounds: CompactLightBounds, all: &Bounds3) -> Self {
         debug_assert!(light < LEAF);
         Self {
-            bounds,
+            bounds: PreparedBounds::new(&bounds.decode(all)),
             index: light | LEAF,
         }
     }
-    fn interior(second: u32, bounds: CompactLightBounds) -> Self {
+    fn interior(second: u32, bounds: CompactLightBounds, all: &Bounds3) -> Self {
         debug_assert!(second < LEAF);
         Self {
-            bounds,
+            bounds: PreparedBounds::new(&bounds.decode(all)),
             index: second,
         }
     }
@@ -97,8 +101,6 @@ pub struct BvhLightSampler {
     nodes: Vec<LightBvhNode>,
     infinite: Vec<LightId>,
     slots: Vec<Slot>,
-    /// Box of every bounded light: the frame of the packed boxes.
-    all: Bounds3,
 }
 
 impl BvhLightSampler {
@@ -134,7 +136,6 @@ impl BvhLightSampler {
             nodes,
             infinite,
             slots,
-            all,
         }
     }
 
@@ -153,7 +154,7 @@ impl BvhLightSampler {
     /// Importance of node `i` at the receiver.
     #[inline]
     fn importance(&self, i: usize, p: Vec3, n: Vec3) -> f32 {
-        self.nodes[i].bounds.importance(p, n, &self.all)
+        self.nodes[i].bounds.importance(p, n)
     }
 
     /// Probabilities of the two children of interior node `i`: I_k/(I₀ + I₁),
