@@ -76,14 +76,20 @@ impl PiecewiseLinear {
         };
         let (lo, hi) = (self.lambda[0], self.lambda[n - 1]);
         let last = n as i32 - 2;
+        let l = lambda.lambdas();
+        // Three passes over the lanes (indices, reads, arithmetic) so that the
+        // first and last run as vector instructions. Lanes outside the table
+        // read segment 0 and are zeroed at the end.
+        let mut seg = [0usize; N_SPECTRUM_SAMPLES];
+        for k in 0..N_SPECTRUM_SAMPLES {
+            // In range the index is ≥ 0, so `as i32` agrees with `as usize`.
+            seg[k] = (((l[k] - start) * inv_step) as i32).clamp(0, last) as usize;
+        }
+        let s = seg.map(|i| self.segments[i]);
         let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
-        for (o, &l) in out.iter_mut().zip(lambda.lambdas()) {
-            if l < lo || l > hi {
-                continue;
-            }
-            // In range, so the index is ≥ 0 and `as i32` agrees with `as usize`.
-            let i = (((l - start) * inv_step) as i32).min(last);
-            *o = lerp_segment(&self.segments[i as usize], l);
+        for k in 0..N_SPECTRUM_SAMPLES {
+            let v = lerp_segment(&s[k], l[k]);
+            out[k] = if l[k] < lo || l[k] > hi { 0.0 } else { v };
         }
         SampledSpectrum(out)
     }
