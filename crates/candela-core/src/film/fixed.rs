@@ -138,7 +138,9 @@ mod tests {
             }
             (v * exp2i(bits)).round().clamp(-LIMIT, LIMIT) as i128
         };
-        let mut vals = vec![0.0, -0.0, 5e-324, 1e-300, 0.5, 1.5, 2.5, -0.5, -2.5, 1e30, 1e300];
+        let mut vals = vec![
+            0.0, -0.0, 5e-324, 1e-300, 0.5, 1.5, 2.5, -0.5, -2.5, 1e30, 1e300,
+        ];
         for k in 40..=60 {
             let p = exp2i(k);
             for d in [-1.0, -0.5, 0.0, 0.5, 1.0] {
@@ -159,7 +161,11 @@ mod tests {
         for &v in &vals {
             for v in [v, -v] {
                 for bits in [0, SQUARE_BITS, VALUE_BITS] {
-                    assert_eq!(quantise(v, bits), reference(v, bits), "{v:e} at {bits} bits");
+                    assert_eq!(
+                        quantise(v, bits),
+                        reference(v, bits),
+                        "{v:e} at {bits} bits"
+                    );
                 }
             }
         }

@@ -289,7 +289,10 @@ impl Triangle {
         };
         let wo = Vec3A::from(wo).normalize_or_zero();
         let mut si = SurfaceInteraction::from_geometry(it, wo.into(), dpdu.into(), dpdv.into());
-        si.face_index = mesh.face_indices.as_ref().map_or(0, |f| f[self.index as usize]);
+        si.face_index = mesh
+            .face_indices
+            .as_ref()
+            .map_or(0, |f| f[self.index as usize]);
         if let Some(ns) = &mesh.n {
             let ns_v = [
                 Vec3A::from(ns[v[0]]),

@@ -198,12 +198,8 @@ impl Spectrum {
                 poly,
                 scale,
                 illuminant,
-            } => {
-                (poly.sample(lambda) * *scale) * illuminant.sample(lambda)
-            }
-            Spectrum::Blackbody { .. } => {
-                SampledSpectrum::from_fn(|i| self.eval(lambda.lambda(i)))
-            }
+            } => (poly.sample(lambda) * *scale) * illuminant.sample(lambda),
+            Spectrum::Blackbody { .. } => SampledSpectrum::from_fn(|i| self.eval(lambda.lambda(i))),
         }
     }
     /// An upper bound of the function.

@@ -258,7 +258,12 @@ fn sampled_spectra_equal_pointwise_evaluation_bit_for_bit() {
             let lambda = SampledWavelengths::from_parts(*l, [1.0; N_SPECTRUM_SAMPLES]);
             let got = s.sample(&lambda);
             for i in 0..N_SPECTRUM_SAMPLES {
-                assert_eq!(got[i].to_bits(), s.eval(l[i]).to_bits(), "{s:?} at {}", l[i]);
+                assert_eq!(
+                    got[i].to_bits(),
+                    s.eval(l[i]).to_bits(),
+                    "{s:?} at {}",
+                    l[i]
+                );
             }
         }
     }
@@ -275,5 +280,32 @@ fn sampled_spectra_equal_pointwise_evaluation_bit_for_bit() {
         let l = lambda.lambda(i);
         let want = scale * poly.eval(l) * cs.illuminant_table.eval(l);
         assert_eq!(got[i].to_bits(), want.to_bits(), "illuminant lift at {l}");
+    }
+}
+
+/// `cie_xyz_sampled` is `cie_xyz` lane by lane, bit for bit, inside the
+/// visible range, at its ends, just outside it and for NaN.
+#[test]
+fn cie_xyz_sampled_equals_cie_xyz_bit_for_bit() {
+    use super::cie_xyz_sampled;
+    let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        300.0 + (rng >> 40) as f32 / (1u64 << 24) as f32 * 600.0
+    };
+    let mut cases: Vec<[f32; 4]> = (0..50_000)
+        .map(|_| [next(), next(), next(), next()])
+        .collect();
+    cases.push([LAMBDA_MIN, LAMBDA_MAX, LAMBDA_MIN - 1e-3, LAMBDA_MAX + 1e-3]);
+    cases.push([f32::NAN, 830.0f32.next_down(), 360.0f32.next_up(), 555.5]);
+    for lambda in cases {
+        let got = cie_xyz_sampled(&lambda);
+        for k in 0..4 {
+            let want = cie_xyz(lambda[k]);
+            let same = (0..3).all(|c| got[k][c].to_bits() == want[c].to_bits());
+            assert!(same, "λ {}: {:?} vs {:?}", lambda[k], got[k], want);
+        }
     }
 }
