@@ -196,6 +196,29 @@ impl SurfaceInteraction {
         }
     }
 
+    /// A hit whose geometric normal `it.n` is already known (so not
+    /// recomputed from ∂p/∂u × ∂p/∂v); shading geometry starts equal to it.
+    #[inline]
+    pub fn from_geometry(it: Interaction, wo: Vec3, dpdu: Vec3, dpdv: Vec3) -> Self {
+        Self {
+            it,
+            wo,
+            dpdu,
+            dpdv,
+            shading: ShadingGeometry {
+                n: it.n,
+                dpdu,
+                dpdv,
+                dndu: Vec3::ZERO,
+                dndv: Vec3::ZERO,
+            },
+            face_index: 0,
+            material: None,
+            area_light: None,
+            diff: Differentials::default(),
+        }
+    }
+
     /// Position.
     #[inline]
     pub fn p(&self) -> Vec3 {

@@ -27,7 +27,7 @@ pub use layered::{CoatedConductorBxdf, CoatedDiffuseBxdf, LayerParams, LayeredBx
 pub use microfacet::TrowbridgeReitz;
 pub use thin_dielectric::ThinDielectricBxdf;
 
-use crate::math::{Frame, Vec2, Vec3};
+use crate::math::{FrameA, Vec2, Vec3, Vec3A};
 use crate::sampling::PdfSolidAngle;
 use crate::spectrum::SampledSpectrum;
 use bitflags::bitflags;
@@ -290,7 +290,7 @@ impl From<CoatedConductorBxdf> for Bxdf {
 /// A BxDF placed in a shading frame.
 #[derive(Clone, Copy, Debug)]
 pub struct Bsdf {
-    frame: Frame,
+    frame: FrameA,
     /// The local scattering model.
     pub bxdf: Bxdf,
 }
@@ -299,7 +299,7 @@ impl Bsdf {
     /// Places `bxdf` in the frame with normal `ns` and tangent `dpdus`.
     pub fn new(ns: Vec3, dpdus: Vec3, bxdf: Bxdf) -> Self {
         Self {
-            frame: Frame::from_xz(dpdus.normalize_or_zero(), ns),
+            frame: FrameA::from_xz(Vec3A::from(dpdus).normalize_or_zero(), ns.into()),
             bxdf,
         }
     }
@@ -316,7 +316,7 @@ impl Bsdf {
     /// Shading normal.
     #[inline]
     pub fn ns(&self) -> Vec3 {
-        self.frame.z
+        self.frame.z.into()
     }
     /// Lobes present.
     #[inline]

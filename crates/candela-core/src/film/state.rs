@@ -156,9 +156,10 @@ impl FilmState {
             .map(|(dst, src)| {
                 let mut sat = 0;
                 let mut q = vec![0i128; stride];
+                let bits: Vec<i32> = (0..pstride).map(|c| layout.bits(c)).collect();
                 for (d, s) in dst.chunks_mut(stride).zip(src.chunks(pstride)) {
-                    for c in 0..pstride {
-                        q[c] = quantise(s[c], layout.bits(c));
+                    for ((q, &v), &b) in q.iter_mut().zip(s).zip(&bits) {
+                        *q = quantise(v, b);
                     }
                     if layout.variance {
                         let v = pass_value(s, &m);

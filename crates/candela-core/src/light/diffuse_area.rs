@@ -55,7 +55,10 @@ use crate::sampling::{
     cosine_hemisphere_pdf, murmur_hash64a, sample_cosine_hemisphere, PdfArea, PdfSolidAngle,
     ONE_MINUS_EPSILON,
 };
-use crate::shape::{Shape, ShapeSampleContext};
+use crate::shape::{
+    area_sample_to_solid_angle, Shape, ShapeSample, ShapeSampleContext, ShapeSampleSa,
+    TriangleSampler,
+};
 use crate::spectrum::{ColorSpace, Rgb, SampledSpectrum, SampledWavelengths, SpectrumKind};
 use crate::texture::{FloatTexture, TextureEvalContext};
 use std::sync::Arc;
@@ -76,6 +79,8 @@ enum Emission {
 #[derive(Clone, Debug)]
 pub struct DiffuseAreaLight {
     shape: Shape,
+    /// The triangle's sampling data gathered once, when the shape is a triangle.
+    triangle: Option<TriangleSampler>,
     area: f32,
     emission: Emission,
     scale: f32,
@@ -120,8 +125,13 @@ impl DiffuseAreaLight {
 
     fn with_emission(shape: Shape, emission: Emission, scale: f32, two_sided: bool) -> Self {
         let area = shape.area();
+        let triangle = match &shape {
+            Shape::Triangle(t) => Some(t.sampler()),
+            _ => None,
+        };
         Self {
             shape,
+            triangle,
             area,
             emission,
             scale,
@@ -239,6 +249,24 @@ impl DiffuseAreaLight {
         }
     }
 
+    /// A point on the shape by area ([`Shape::sample_area`], from the
+    /// gathered data for a triangle).
+    fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
+        match &self.triangle {
+            Some(t) => t.sample_area(u),
+            None => self.shape.sample_area(u),
+        }
+    }
+
+    /// A point on the shape by solid angle at `ctx` ([`Shape::sample_from`],
+    /// from the gathered data for a triangle).
+    fn sample_from(&self, ctx: &ShapeSampleContext, u: Vec2) -> Option<ShapeSampleSa> {
+        match &self.triangle {
+            Some(t) => area_sample_to_solid_angle(ctx, t.sample_area(u)?),
+            None => self.shape.sample_from(ctx, u),
+        }
+    }
+
     /// Samples a point on the shape as seen from `ctx`.
     pub fn sample_li(
         &self,
@@ -246,7 +274,7 @@ impl DiffuseAreaLight {
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let ss = self.shape.sample_from(&Self::shape_ctx(ctx), u)?;
+        let ss = self.sample_from(&Self::shape_ctx(ctx), u)?;
         let d = ss.intr.p - ctx.p;
         if ss.pdf.0 == 0.0 || d.length_squared() == 0.0 {
             return None;
@@ -277,7 +305,7 @@ impl DiffuseAreaLight {
         u2: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLeSample> {
-        let ss = self.shape.sample_area(u1)?;
+        let ss = self.sample_area(u1)?;
         if self.alpha_masked(ss.intr.p, ss.intr.uv) {
             return None;
         }

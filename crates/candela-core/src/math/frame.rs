@@ -1,6 +1,6 @@
 //! Orthonormal frames: the shading frame of BSDFs and local light frames.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// An orthonormal basis; `z` is the normal direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -23,17 +23,7 @@ impl Frame {
 
     /// Frame with `z = n` whose `x` follows the tangent `t` (Gram–Schmidt).
     pub fn from_xz(t: Vec3, n: Vec3) -> Self {
-        let x = t - n * n.dot(t);
-        let len = x.length();
-        if len.is_nan() || len <= 1e-12 || !len.is_finite() {
-            return Self::from_z(n);
-        }
-        let x = x / len;
-        Self {
-            x,
-            y: n.cross(x),
-            z: n,
-        }
+        FrameA::from_xz(t.into(), n.into()).into()
     }
 
     /// World (or parent) space → local coordinates.
@@ -46,6 +36,73 @@ impl Frame {
     #[inline]
     pub fn from_local(&self, v: Vec3) -> Vec3 {
         self.x * v.x + self.y * v.y + self.z * v.z
+    }
+}
+
+/// A [`Frame`] held in 16-byte `Vec3A` vectors, for the frames built and
+/// used at every hit (the BSDF's): the same operations lane by lane in the
+/// same order as on `Vec3`, so the same numbers, but as whole-register SIMD.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameA {
+    /// First tangent.
+    pub x: Vec3A,
+    /// Second tangent.
+    pub y: Vec3A,
+    /// Normal.
+    pub z: Vec3A,
+}
+
+impl FrameA {
+    /// Frame with `z = n` whose `x` follows the tangent `t` (Gram–Schmidt);
+    /// [`Frame::from_z`] when `t` is (nearly) parallel to `n`.
+    #[inline]
+    pub fn from_xz(t: Vec3A, n: Vec3A) -> Self {
+        let x = t - n * n.dot(t);
+        let len = x.length();
+        if len.is_nan() || len <= 1e-12 || !len.is_finite() {
+            return Frame::from_z(n.into()).into();
+        }
+        let x = x / len;
+        Self {
+            x,
+            y: n.cross(x),
+            z: n,
+        }
+    }
+
+    /// World (or parent) space → local coordinates.
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        let v = Vec3A::from(v);
+        Vec3::new(v.dot(self.x), v.dot(self.y), v.dot(self.z))
+    }
+
+    /// Local coordinates → world (or parent) space.
+    #[inline]
+    pub fn from_local(&self, v: Vec3) -> Vec3 {
+        (self.x * v.x + self.y * v.y + self.z * v.z).into()
+    }
+}
+
+impl From<Frame> for FrameA {
+    #[inline]
+    fn from(f: Frame) -> Self {
+        Self {
+            x: f.x.into(),
+            y: f.y.into(),
+            z: f.z.into(),
+        }
+    }
+}
+
+impl From<FrameA> for Frame {
+    #[inline]
+    fn from(f: FrameA) -> Self {
+        Self {
+            x: f.x.into(),
+            y: f.y.into(),
+            z: f.z.into(),
+        }
     }
 }
 

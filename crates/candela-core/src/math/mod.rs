@@ -11,8 +11,8 @@ mod transform;
 pub use animated::AnimatedTransform;
 pub use bounds::Bounds3;
 pub use cone::DirectionCone;
-pub use frame::Frame;
-pub use glam::{Mat3, Mat4, UVec2, Vec2, Vec3, Vec4};
+pub use frame::{Frame, FrameA};
+pub use glam::{Mat3, Mat4, UVec2, Vec2, Vec3, Vec3A, Vec4};
 pub use ray::{offset_ray_origin, spawn_ray, spawn_ray_to, Ray, SHADOW_EPSILON};
 pub use transform::{perspective, Transform};
 

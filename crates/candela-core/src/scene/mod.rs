@@ -170,7 +170,9 @@ impl Scene {
     /// Closest hit along `ray` before `t_max`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceInteraction> {
         let n = self.primitives.len() as u32;
-        let wr = WatertightRay::new(ray);
+        // The watertight constants, made once the BVH meets an item it does
+        // not test itself (never in a scene of opaque triangles).
+        let mut wr = None;
         // The last hit the closure accepted: the closest one if an item the
         // BVH does not pack wins.
         let mut other = None;
@@ -180,7 +182,8 @@ impl Scene {
                 other = Some(Err(si));
                 return Some(t);
             }
-            let hit = self.primitives[i as usize].hit(ray, &wr, t_max)?;
+            let wr = wr.get_or_insert_with(|| WatertightRay::new(ray));
+            let hit = self.primitives[i as usize].hit(ray, wr, t_max)?;
             other = Some(Ok((i, hit)));
             Some(hit.t())
         })?;
@@ -208,12 +211,13 @@ impl Scene {
     /// True if anything blocks `ray` before `t_max`.
     pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
         let n = self.primitives.len() as u32;
-        let wr = WatertightRay::new(ray);
+        let mut wr = None;
         self.bvh.intersect_p(ray, t_max, |i, ray, t_max| {
             if i >= n {
                 return self.movers[(i - n) as usize].intersect_p(ray, t_max);
             }
-            self.primitives[i as usize].blocks(ray, &wr, t_max)
+            let wr = wr.get_or_insert_with(|| WatertightRay::new(ray));
+            self.primitives[i as usize].blocks(ray, wr, t_max)
         })
     }
 

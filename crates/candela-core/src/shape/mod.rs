@@ -50,7 +50,9 @@ pub use disk::Disk;
 pub use loop_subdiv::{loop_subdivide, LoopSubdivError, LoopSurface};
 pub use mesh::{MeshError, TriangleMesh};
 pub use sphere::Sphere;
-pub use triangle::{intersect_triangle, Triangle, TriangleIntersection, WatertightRay};
+pub use triangle::{
+    intersect_triangle, Triangle, TriangleIntersection, TriangleSampler, WatertightRay,
+};
 
 /// A closest-hit candidate from [`Shape::intersect_deferred`].
 #[derive(Clone, Copy, Debug)]

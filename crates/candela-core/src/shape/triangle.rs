@@ -15,7 +15,7 @@
 
 use super::{ShapeIntersection, ShapeSample, TriangleMesh};
 use crate::interaction::{Interaction, SurfaceInteraction};
-use crate::math::{gamma, Bounds3, Frame, Ray, Vec2, Vec3};
+use crate::math::{gamma, Bounds3, Frame, Ray, Vec2, Vec3, Vec3A};
 use crate::sampling::{sample_uniform_triangle, PdfArea};
 use std::sync::Arc;
 
@@ -243,9 +243,10 @@ impl Triangle {
     }
 
     /// Per-vertex uv (or the default parameterisation).
-    fn uvs(&self) -> [Vec2; 3] {
+    #[inline]
+    fn uvs_of(&self, v: [usize; 3]) -> [Vec2; 3] {
         match &self.mesh.uv {
-            Some(uv) => self.mesh.vertex_indices(self.index).map(|i| uv[i]),
+            Some(uv) => [uv[v[0]], uv[v[1]], uv[v[2]]],
             None => DEFAULT_UV,
         }
     }
@@ -256,100 +257,142 @@ impl Triangle {
         self.mesh.reverse_orientation ^ self.mesh.transform_swaps_handedness
     }
 
-    /// Geometric normal at barycentrics `b`, oriented as pbrt-v4 does: towards
-    /// the interpolated shading normal if the mesh has normals, else by [`Self::flips`].
-    fn oriented_normal(&self, b: [f32; 3]) -> Vec3 {
-        let [p0, p1, p2] = self.positions();
-        let n = (p0 - p2).cross(p1 - p2).normalize_or_zero();
-        match &self.mesh.n {
-            Some(ns) => {
-                let v = self.mesh.vertex_indices(self.index);
-                let nsi = b[0] * ns[v[0]] + b[1] * ns[v[1]] + b[2] * ns[v[2]];
-                if n.dot(nsi) < 0.0 {
-                    -n
-                } else {
-                    n
-                }
-            }
-            None if self.flips() => -n,
-            None => n,
-        }
-    }
-
     /// Builds the surface interaction of a hit [pbrt-v4 §6.5.4].
+    ///
+    /// The arithmetic runs on 16-byte `Vec3A` vectors: lane by lane the same
+    /// operations in the same order as on `Vec3` (so the same bits), but as
+    /// whole-register SIMD instead of the shuffles the compiler makes of
+    /// three-float vectors.
     pub(crate) fn interaction(&self, ti: &TriangleIntersection, wo: Vec3) -> SurfaceInteraction {
-        let [p0, p1, p2] = self.positions();
-        let uv = self.uvs();
+        let mesh = &*self.mesh;
+        let v = mesh.vertex_indices(self.index);
+        let p0 = Vec3A::from(mesh.p[v[0]]);
+        let p1 = Vec3A::from(mesh.p[v[1]]);
+        let p2 = Vec3A::from(mesh.p[v[2]]);
+        let uv = self.uvs_of(v);
         let (dpdu, dpdv) = position_derivatives([p0, p1, p2], uv);
         let b = ti.b;
         let p_hit = b[0] * p0 + b[1] * p1 + b[2] * p2;
         let uv_hit = b[0] * uv[0] + b[1] * uv[1] + b[2] * uv[2];
         let abs_sum = (b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs();
-        let p_error = gamma(7) * abs_sum;
-        let wo = wo.normalize_or_zero();
-        let mut si = SurfaceInteraction::new(
-            p_hit,
-            p_error,
-            uv_hit,
-            wo,
-            dpdu,
-            dpdv,
-            Vec3::ZERO,
-            Vec3::ZERO,
-            false,
-        );
-        si.face_index = self
-            .mesh
-            .face_indices
-            .as_ref()
-            .map_or(0, |f| f[self.index as usize]);
         // The geometric normal comes from the vertices, not from dpdu × dpdv.
         let mut n = (p0 - p2).cross(p1 - p2).normalize_or_zero();
         if self.flips() {
             n = -n;
         }
-        si.it.n = n;
-        si.shading.n = n;
-        if let Some(ns) = &self.mesh.n {
-            self.set_shading(&mut si, ns, b, uv);
+        let it = Interaction {
+            p: p_hit.into(),
+            p_error: (gamma(7) * abs_sum).into(),
+            n: n.into(),
+            uv: uv_hit,
+            time: 0.0,
+        };
+        let wo = Vec3A::from(wo).normalize_or_zero();
+        let mut si = SurfaceInteraction::from_geometry(it, wo.into(), dpdu.into(), dpdv.into());
+        si.face_index = mesh
+            .face_indices
+            .as_ref()
+            .map_or(0, |f| f[self.index as usize]);
+        if let Some(ns) = &mesh.n {
+            let ns_v = [
+                Vec3A::from(ns[v[0]]),
+                Vec3A::from(ns[v[1]]),
+                Vec3A::from(ns[v[2]]),
+            ];
+            set_shading(&mut si, n, dpdu, ns_v, b, uv);
         }
         si
     }
 
-    /// Shading geometry from interpolated per-vertex normals; the geometric
-    /// normal is flipped to the shading normal's side [pbrt-v4 §6.5.4].
-    fn set_shading(&self, si: &mut SurfaceInteraction, ns_v: &[Vec3], b: [f32; 3], uv: [Vec2; 3]) {
-        let v = self.mesh.vertex_indices(self.index);
-        let ns = b[0] * ns_v[v[0]] + b[1] * ns_v[v[1]] + b[2] * ns_v[v[2]];
-        let ns = if ns.length_squared() > 0.0 {
-            ns.normalize()
-        } else {
-            si.it.n
-        };
-        let mut ss = si.dpdu;
-        let mut ts = ns.cross(ss);
-        if ts.length_squared() > 0.0 {
-            ss = ts.cross(ns);
-        } else {
-            let f = Frame::from_z(ns);
-            (ss, ts) = (f.x, f.y);
+    /// The triangle's sampling data, computed once (see [`TriangleSampler`]).
+    pub fn sampler(&self) -> TriangleSampler {
+        let mesh = &*self.mesh;
+        let v = mesh.vertex_indices(self.index);
+        let p = [mesh.p[v[0]], mesh.p[v[1]], mesh.p[v[2]]];
+        TriangleSampler {
+            p,
+            uv: self.uvs_of(v),
+            n: (p[0] - p[2]).cross(p[1] - p[2]).normalize_or_zero(),
+            ns: mesh.n.as_ref().map(|ns| [ns[v[0]], ns[v[1]], ns[v[2]]]),
+            flip: self.flips(),
+            area: self.area(),
         }
-        let (dndu, dndv) = normal_derivatives([ns_v[v[0]], ns_v[v[1]], ns_v[v[2]]], uv);
-        // candela's flag `false` means: the geometric normal follows the shading normal.
-        si.set_shading_geometry(ns, ss, ts, dndu, dndv, false);
     }
 
     /// A point uniformly distributed by area; `None` for zero-area triangles.
     pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
-        let area = self.area();
+        self.sampler().sample_area(u)
+    }
+}
+
+/// Shading geometry from the interpolated per-vertex normals `ns_v` (`n`
+/// and `dpdu`: the hit's geometric normal and ∂p/∂u); the geometric normal
+/// is flipped to the shading normal's side [pbrt-v4 §6.5.4].
+fn set_shading(
+    si: &mut SurfaceInteraction,
+    n: Vec3A,
+    dpdu: Vec3A,
+    ns_v: [Vec3A; 3],
+    b: [f32; 3],
+    uv: [Vec2; 3],
+) {
+    let ns = b[0] * ns_v[0] + b[1] * ns_v[1] + b[2] * ns_v[2];
+    let ns = if ns.length_squared() > 0.0 {
+        normalize(ns)
+    } else {
+        n
+    };
+    let mut ss = dpdu;
+    let mut ts = ns.cross(ss);
+    if ts.length_squared() > 0.0 {
+        ss = ts.cross(ns);
+    } else {
+        let f = Frame::from_z(ns.into());
+        (ss, ts) = (f.x.into(), f.y.into());
+    }
+    let (dndu, dndv) = normal_derivatives(ns_v, uv);
+    // candela's flag `false` means: the geometric normal follows the shading normal.
+    si.set_shading_geometry(
+        ns.into(),
+        ss.into(),
+        ts.into(),
+        dndu.into(),
+        dndv.into(),
+        false,
+    );
+}
+
+/// What sampling a point on one triangle needs, gathered once (area lights
+/// sample the same triangle for every shadow ray): the vertices, their uv
+/// and shading normals, and the unit normal and area, computed as
+/// [`Triangle::sample_area`] computes them on the fly.
+#[derive(Clone, Debug)]
+pub struct TriangleSampler {
+    p: [Vec3; 3],
+    uv: [Vec2; 3],
+    /// Unit (p₀ − p₂) × (p₁ − p₂), before orientation.
+    n: Vec3,
+    /// Per-vertex shading normals, which orient `n` at each point.
+    ns: Option<[Vec3; 3]>,
+    /// Negate `n` (meshes without shading normals).
+    flip: bool,
+    area: f32,
+}
+
+impl TriangleSampler {
+    /// A point uniformly distributed by area [pbrt-v4 `Triangle::Sample`];
+    /// `None` for zero-area triangles.
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> Option<ShapeSample> {
+        let area = self.area;
         if area.is_nan() || area <= 0.0 {
             return None;
         }
-        let [p0, p1, p2] = self.positions();
+        let [p0, p1, p2] = self.p;
         let b = sample_uniform_triangle(u);
         let p = b[0] * p0 + b[1] * p1 + b[2] * p2;
         let abs_sum = (b[0] * p0).abs() + (b[1] * p1).abs() + (b[2] * p2).abs();
-        let uv = self.uvs();
+        let uv = self.uv;
         let intr = Interaction {
             p,
             p_error: gamma(6) * abs_sum,
@@ -362,11 +405,39 @@ impl Triangle {
             pdf: PdfArea(1.0 / area),
         })
     }
+
+    /// The geometric normal at barycentrics `b`, oriented as pbrt-v4 does:
+    /// towards the interpolated shading normal if the mesh has normals, else
+    /// by the orientation flag.
+    #[inline]
+    fn oriented_normal(&self, b: [f32; 3]) -> Vec3 {
+        let n = self.n;
+        match &self.ns {
+            Some(ns) => {
+                let nsi = b[0] * ns[0] + b[1] * ns[1] + b[2] * ns[2];
+                if n.dot(nsi) < 0.0 {
+                    -n
+                } else {
+                    n
+                }
+            }
+            None if self.flip => -n,
+            None => n,
+        }
+    }
+}
+
+/// `v` scaled to unit length as `Vec3::normalize` does it (by the
+/// reciprocal length; `Vec3A::normalize` divides, which rounds differently).
+#[inline]
+fn normalize(v: Vec3A) -> Vec3A {
+    v * v.length_recip()
 }
 
 /// ∂p/∂u and ∂p/∂v from vertex positions and uv; falls back to an arbitrary
 /// tangent frame for degenerate uv [pbrt-v4 §6.5.4].
-fn position_derivatives(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
+#[inline]
+fn position_derivatives(p: [Vec3A; 3], uv: [Vec2; 3]) -> (Vec3A, Vec3A) {
     let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
     let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
     let det = duv02.x * duv12.y - duv02.y * duv12.x;
@@ -378,6 +449,13 @@ fn position_derivatives(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
             return (dpdu, dpdv);
         }
     }
+    let (dx, dy) = fallback_frame(p.map(Vec3::from));
+    (dx.into(), dy.into())
+}
+
+/// A tangent frame around the triangle's normal, for degenerate uv.
+#[cold]
+fn fallback_frame(p: [Vec3; 3]) -> (Vec3, Vec3) {
     let ng = (p[2] - p[0]).cross(p[1] - p[0]);
     let ng = if ng.length_squared() > 0.0 {
         ng
@@ -390,7 +468,8 @@ fn position_derivatives(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
 }
 
 /// ∂n/∂u and ∂n/∂v of the interpolated shading normal [pbrt-v4 §6.5.4].
-fn normal_derivatives(n: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
+#[inline]
+fn normal_derivatives(n: [Vec3A; 3], uv: [Vec2; 3]) -> (Vec3A, Vec3A) {
     let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
     let (dn1, dn2) = (n[0] - n[2], n[1] - n[2]);
     let det = duv02.x * duv12.y - duv02.y * duv12.x;
@@ -403,8 +482,8 @@ fn normal_derivatives(n: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
     }
     let dn = (n[2] - n[0]).cross(n[1] - n[0]);
     if dn.length_squared() == 0.0 {
-        return (Vec3::ZERO, Vec3::ZERO);
+        return (Vec3A::ZERO, Vec3A::ZERO);
     }
-    let f = Frame::from_z(dn.normalize());
-    (f.x, f.y)
+    let f = Frame::from_z(normalize(dn).into());
+    (f.x.into(), f.y.into())
 }

@@ -259,21 +259,18 @@ impl ColorSpace {
         let rgb = Rgb::new(rgb.r.max(0.0), rgb.g.max(0.0), rgb.b.max(0.0));
         if kind == SpectrumKind::Albedo {
             let p = table.coeffs(rgb);
-            return SampledSpectrum::from_fn(|i| p.eval(lambda.lambda(i)));
+            return p.sample(lambda);
         }
         let scale = 2.0 * rgb.r.max(rgb.g).max(rgb.b);
         if scale == 0.0 {
             return SampledSpectrum::zero();
         }
         let p = table.coeffs(Rgb::new(rgb.r / scale, rgb.g / scale, rgb.b / scale));
-        SampledSpectrum::from_fn(|i| {
-            let l = lambda.lambda(i);
-            let v = scale * p.eval(l);
-            match kind {
-                SpectrumKind::Illuminant => v * self.illuminant_table.eval(l),
-                _ => v,
-            }
-        })
+        let v = p.sample(lambda) * scale;
+        match kind {
+            SpectrumKind::Illuminant => v * self.illuminant_table.sample(lambda),
+            _ => v,
+        }
     }
 }
 

@@ -52,6 +52,32 @@ pub fn cie_xyz(lambda: f32) -> [f32; 3] {
     ]
 }
 
+/// [`cie_xyz`] at the path's wavelengths: the same interpolation, with the
+/// indices, table reads and arithmetic each done for all lanes at once.
+#[inline]
+pub fn cie_xyz_sampled(lambda: &[f32; N_SPECTRUM_SAMPLES]) -> [[f32; 3]; N_SPECTRUM_SAMPLES] {
+    use data::cie::{CIE_X, CIE_Y, CIE_Z};
+    let last = CIE_X.len() - 2;
+    let mut idx = [0usize; N_SPECTRUM_SAMPLES];
+    let mut t = [0.0f32; N_SPECTRUM_SAMPLES];
+    for k in 0..N_SPECTRUM_SAMPLES {
+        let x = lambda[k] - LAMBDA_MIN;
+        // Below the range (or NaN) the index saturates to 0 and the lane is
+        // zeroed below; in range `as i32` agrees with `cie_xyz`'s `as usize`.
+        idx[k] = (x as i32).clamp(0, last as i32) as usize;
+        t[k] = x - idx[k] as f32;
+    }
+    let mut out = [[0.0f32; 3]; N_SPECTRUM_SAMPLES];
+    for k in 0..N_SPECTRUM_SAMPLES {
+        let i = idx[k];
+        let f = |a: &[f32; 471]| a[i] + t[k] * (a[i + 1] - a[i]);
+        if (LAMBDA_MIN..=LAMBDA_MAX).contains(&lambda[k]) {
+            out[k] = [f(&CIE_X), f(&CIE_Y), f(&CIE_Z)];
+        }
+    }
+    out
+}
+
 /// The photometric value of a spectral estimate at sampled wavelengths:
 /// K_m·(1/N) Σ_k ȳ(λ_k)·e_k/p(λ_k), with V(λ) = ȳ(λ) un-normalised (ȳ(555) = 1,
 /// *not* divided by ∫ȳ as pbrt-v4's sensor Y is). Radiance in W/(m²·sr·nm)

@@ -11,7 +11,9 @@
 //! interpolation of fits.
 
 use super::color::{ColorSpace, Rgb};
-use super::{cie_xyz, LAMBDA_MAX, LAMBDA_MIN};
+use super::{
+    cie_xyz, SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN, N_SPECTRUM_SAMPLES,
+};
 
 /// Coefficients of s(λ) = S(c₀λ² + c₁λ + c₂), λ in nm.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -60,6 +62,28 @@ impl RgbSigmoidPolynomial {
             (self.c0 as f64 * l + self.c1 as f64) * l + self.c2 as f64
         };
         sigmoid(x) as f32
+    }
+    /// s(λ) at the path's wavelengths: [`Self::eval`] lane by lane (the
+    /// same f64 arithmetic, so the same bits), with the constant-spectrum
+    /// test made once and the sigmoid written without branches so that the
+    /// four lanes run as vector instructions.
+    #[inline]
+    pub fn sample(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        if self.c2.is_infinite() && self.c0 == 0.0 && self.c1 == 0.0 {
+            return SampledSpectrum::splat(sigmoid(self.c2 as f64) as f32);
+        }
+        let (c0, c1, c2) = (self.c0 as f64, self.c1 as f64, self.c2 as f64);
+        let l = lambda.lambdas();
+        let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
+        for k in 0..N_SPECTRUM_SAMPLES {
+            let l = l[k] as f64;
+            let x = (c0 * l + c1) * l + c2;
+            let s = 0.5 + x / (2.0 * (1.0 + x * x).sqrt());
+            // `sigmoid`'s limits at ±∞, as a select rather than a branch.
+            let limit = if x > 0.0 { 1.0 } else { 0.0 };
+            out[k] = (if x.is_infinite() { limit } else { s }) as f32;
+        }
+        SampledSpectrum(out)
     }
     /// Maximum over 360–830 nm (endpoints or the parabola's vertex).
     pub fn max_value(&self) -> f32 {

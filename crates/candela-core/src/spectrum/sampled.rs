@@ -47,12 +47,15 @@ impl SampledSpectrum {
     /// True when every sample is exactly zero.
     #[inline]
     pub fn is_black(&self) -> bool {
-        self.0.iter().all(|&v| v == 0.0)
+        // `&` rather than `&&`: four compares and no branches.
+        let [a, b, c, d] = self.0;
+        (a == 0.0) & (b == 0.0) & (c == 0.0) & (d == 0.0)
     }
     /// True when any sample is NaN or infinite.
     #[inline]
     pub fn has_non_finite(&self) -> bool {
-        self.0.iter().any(|v| !v.is_finite())
+        let [a, b, c, d] = self.0;
+        !(a.is_finite() & b.is_finite() & c.is_finite() & d.is_finite())
     }
     /// Arithmetic mean of the samples.
     #[inline]

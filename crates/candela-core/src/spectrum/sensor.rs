@@ -27,7 +27,9 @@ use super::color::{white_balance, ColorSpace};
 use super::data::swatches::{SWATCHES, SWATCH_START};
 use super::daylight::daylight;
 use super::spectra::{spectrum_to_xyz, PiecewiseLinear, Spectrum};
-use super::{cie_xyz, SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN};
+use super::{
+    cie_xyz, cie_xyz_sampled, SampledSpectrum, SampledWavelengths, LAMBDA_MAX, LAMBDA_MIN,
+};
 use glam::{DMat3, DVec3, Mat3};
 use std::sync::{Arc, OnceLock};
 
@@ -195,14 +197,22 @@ impl PixelSensor {
     /// 1/`SpectrumToPhotometric` scale, so a 1-nit white light reads 1.
     pub fn to_sensor_rgb(&self, l: SampledSpectrum, lambda: &SampledWavelengths) -> [f32; 3] {
         let l = l.safe_div(lambda.pdf());
+        let b = match self.response {
+            Response::Xyz => cie_xyz_sampled(lambda.lambdas()),
+            Response::Camera(_) => std::array::from_fn(|i| self.sensitivities(lambda.lambda(i))),
+        };
         let mut out = [0.0f32; 3];
         for i in 0..super::N_SPECTRUM_SAMPLES {
-            let b = self.sensitivities(lambda.lambda(i));
             for k in 0..3 {
-                out[k] += b[k] * l[i];
+                out[k] += b[i][k] * l[i];
             }
         }
-        out.map(|v| v / super::N_SPECTRUM_SAMPLES as f32 * self.imaging_ratio)
+        let n = super::N_SPECTRUM_SAMPLES as f32;
+        [
+            out[0] / n * self.imaging_ratio,
+            out[1] / n * self.imaging_ratio,
+            out[2] / n * self.imaging_ratio,
+        ]
     }
 
     /// (b̄_r, b̄_g, b̄_b) at `lambda`.

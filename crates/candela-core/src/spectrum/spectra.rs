@@ -4,6 +4,7 @@ use super::color::ColorSpace;
 use super::rgb2spec::RgbSigmoidPolynomial;
 use super::{
     cie_xyz, Rgb, SampledSpectrum, SampledWavelengths, Xyz, CIE_Y_INTEGRAL, LAMBDA_MAX, LAMBDA_MIN,
+    N_SPECTRUM_SAMPLES,
 };
 use std::sync::Arc;
 
@@ -14,6 +15,9 @@ pub struct PiecewiseLinear {
     values: Vec<f32>,
     /// (first λ, 1/step) when the samples are evenly spaced: O(1) lookup.
     even: Option<(f32, f32)>,
+    /// (λᵢ, λᵢ₊₁, vᵢ, vᵢ₊₁) of every interval, so an evaluation reads one
+    /// 16-byte record (the same numbers as `lambda` and `values`).
+    segments: Vec<[f32; 4]>,
 }
 
 impl PiecewiseLinear {
@@ -29,16 +33,20 @@ impl PiecewiseLinear {
             && lambda
                 .windows(2)
                 .all(|w| ((w[1] - w[0]) - step).abs() <= 1e-4 * step);
+        let values: Vec<f32> = pairs.iter().map(|p| p.1).collect();
         Self {
             even: is_even.then(|| (lambda[0], 1.0 / step)),
+            segments: segments(&lambda, &values),
             lambda,
-            values: pairs.iter().map(|p| p.1).collect(),
+            values,
         }
     }
     /// From evenly spaced values starting at `start` with step `step` [nm].
     pub fn from_even(start: f32, step: f32, values: &[f32]) -> Self {
+        let lambda: Vec<f32> = (0..values.len()).map(|i| start + step * i as f32).collect();
         Self {
-            lambda: (0..values.len()).map(|i| start + step * i as f32).collect(),
+            segments: segments(&lambda, values),
+            lambda,
             values: values.to_vec(),
             even: (step > 0.0).then(|| (start, 1.0 / step)),
         }
@@ -56,13 +64,39 @@ impl PiecewiseLinear {
         if n == 1 {
             return self.values[0];
         }
-        let (l0, l1) = (self.lambda[i], self.lambda[i + 1]);
-        let t = if l1 > l0 { (l - l0) / (l1 - l0) } else { 0.0 };
-        self.values[i] + t * (self.values[i + 1] - self.values[i])
+        lerp_segment(&self.segments[i], l)
+    }
+    /// Values at the path's wavelengths: [`Self::eval`] lane by lane (the
+    /// same arithmetic), with the table checks made once.
+    #[inline]
+    pub fn sample(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let n = self.lambda.len();
+        let Some((start, inv_step)) = self.even.filter(|_| n >= 2) else {
+            return SampledSpectrum::from_fn(|i| self.eval(lambda.lambda(i)));
+        };
+        let (lo, hi) = (self.lambda[0], self.lambda[n - 1]);
+        let last = n as i32 - 2;
+        let l = lambda.lambdas();
+        // Three passes over the lanes (indices, reads, arithmetic) so that the
+        // first and last run as vector instructions. Lanes outside the table
+        // read segment 0 and are zeroed at the end.
+        let mut seg = [0usize; N_SPECTRUM_SAMPLES];
+        for k in 0..N_SPECTRUM_SAMPLES {
+            // In range the index is ≥ 0, so `as i32` agrees with `as usize`.
+            seg[k] = (((l[k] - start) * inv_step) as i32).clamp(0, last) as usize;
+        }
+        let s = seg.map(|i| self.segments[i]);
+        let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
+        for k in 0..N_SPECTRUM_SAMPLES {
+            let v = lerp_segment(&s[k], l[k]);
+            out[k] = if l[k] < lo || l[k] > hi { 0.0 } else { v };
+        }
+        SampledSpectrum(out)
     }
     /// Scales all values.
     pub fn scaled(mut self, s: f32) -> Self {
         self.values.iter_mut().for_each(|v| *v *= s);
+        self.segments = segments(&self.lambda, &self.values);
         self
     }
     /// The (λ, value) samples.
@@ -73,6 +107,20 @@ impl PiecewiseLinear {
     pub fn max_value(&self) -> f32 {
         self.values.iter().copied().fold(0.0, f32::max)
     }
+}
+
+/// The (λᵢ, λᵢ₊₁, vᵢ, vᵢ₊₁) records of [`PiecewiseLinear::segments`].
+fn segments(lambda: &[f32], values: &[f32]) -> Vec<[f32; 4]> {
+    (1..lambda.len())
+        .map(|i| [lambda[i - 1], lambda[i], values[i - 1], values[i]])
+        .collect()
+}
+
+/// Linear interpolation within one segment at `l`.
+#[inline]
+fn lerp_segment(&[l0, l1, v0, v1]: &[f32; 4], l: f32) -> f32 {
+    let t = if l1 > l0 { (l - l0) / (l1 - l0) } else { 0.0 };
+    v0 + t * (v1 - v0)
 }
 
 /// How an RGB value is lifted to a spectrum [pbrt-v4 `SpectrumType`].
@@ -136,12 +184,22 @@ impl Spectrum {
             } => scale * poly.eval(lambda) * illuminant.eval(lambda),
         }
     }
-    /// Values at the path's wavelengths.
+    /// Values at the path's wavelengths: one `match` for all of them, each
+    /// variant evaluating its lanes together with the arithmetic of
+    /// [`Self::eval`] (so the same values).
     #[inline]
     pub fn sample(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Spectrum::Constant(c) => SampledSpectrum::splat(*c),
-            _ => SampledSpectrum::from_fn(|i| self.eval(lambda.lambda(i))),
+            Spectrum::PiecewiseLinear(p) => p.sample(lambda),
+            Spectrum::RgbAlbedo(p) => p.sample(lambda),
+            Spectrum::RgbUnbounded { poly, scale } => poly.sample(lambda) * *scale,
+            Spectrum::RgbIlluminant {
+                poly,
+                scale,
+                illuminant,
+            } => (poly.sample(lambda) * *scale) * illuminant.sample(lambda),
+            Spectrum::Blackbody { .. } => SampledSpectrum::from_fn(|i| self.eval(lambda.lambda(i))),
         }
     }
     /// An upper bound of the function.

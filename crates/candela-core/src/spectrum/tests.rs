@@ -223,3 +223,89 @@ fn rgb_table_round_trips_random_colours() {
     let g = Spectrum::RgbAlbedo(table.coeffs(Rgb::new(0.3, 0.3, 0.3)));
     assert!((g.eval(500.0) - 0.3).abs() < 1e-6);
 }
+
+/// `Spectrum::sample` evaluates all wavelengths with one `match`; it must
+/// give exactly the bits of `eval` at each wavelength, for every variant
+/// (tables evenly and unevenly spaced, RGB spectra of every kind, the
+/// constant-sigmoid limits) and for wavelengths inside, at the ends of and
+/// outside the tables' ranges.
+#[test]
+fn sampled_spectra_equal_pointwise_evaluation_bit_for_bit() {
+    let cs = ColorSpace::srgb();
+    let spectra = [
+        Spectrum::Constant(0.25),
+        named_spectrum("stdillum-D65").unwrap(),
+        named_spectrum("metal-Cu-eta").unwrap(),
+        named_spectrum("glass-BK7").unwrap(),
+        Spectrum::piecewise_linear(&[(400.0, 1.0), (401.5, 2.0), (500.0, 0.5), (700.0, 3.0)]),
+        Spectrum::blackbody(3200.0),
+        Spectrum::rgb_albedo(cs, Rgb::new(0.8, 0.2, 0.1)),
+        Spectrum::rgb_albedo(cs, Rgb::new(0.0, 0.0, 0.0)),
+        Spectrum::rgb_albedo(cs, Rgb::new(1.0, 1.0, 1.0)),
+        Spectrum::rgb_unbounded(cs, Rgb::new(3.0, 0.5, 1.5)),
+        Spectrum::rgb_illuminant(cs, Rgb::new(18.387, 13.9873, 6.75357)),
+    ];
+    let mut rng = Pcg32::new(7, 0);
+    let mut sets: Vec<[f32; N_SPECTRUM_SAMPLES]> = vec![
+        [LAMBDA_MIN, LAMBDA_MAX, 300.0, 900.0],
+        [400.0, 401.5, 700.0, 700.5],
+    ];
+    for _ in 0..2000 {
+        sets.push(std::array::from_fn(|_| 340.0 + 510.0 * rng.uniform_f32()));
+    }
+    for s in &spectra {
+        for l in &sets {
+            let lambda = SampledWavelengths::from_parts(*l, [1.0; N_SPECTRUM_SAMPLES]);
+            let got = s.sample(&lambda);
+            for i in 0..N_SPECTRUM_SAMPLES {
+                assert_eq!(
+                    got[i].to_bits(),
+                    s.eval(l[i]).to_bits(),
+                    "{s:?} at {}",
+                    l[i]
+                );
+            }
+        }
+    }
+    // The colour space's lift of image texels (through its coefficient
+    // table) takes the same paths.
+    let lambda = SampledWavelengths::sample_visible(0.3);
+    let rgb = Rgb::new(0.3, 0.6, 0.9);
+    let scale = 2.0 * rgb.b;
+    let poly = cs
+        .rgb_table()
+        .coeffs(Rgb::new(rgb.r / scale, rgb.g / scale, rgb.b / scale));
+    let got = cs.sample_rgb(rgb, SpectrumKind::Illuminant, &lambda);
+    for i in 0..N_SPECTRUM_SAMPLES {
+        let l = lambda.lambda(i);
+        let want = scale * poly.eval(l) * cs.illuminant_table.eval(l);
+        assert_eq!(got[i].to_bits(), want.to_bits(), "illuminant lift at {l}");
+    }
+}
+
+/// `cie_xyz_sampled` is `cie_xyz` lane by lane, bit for bit, inside the
+/// visible range, at its ends, just outside it and for NaN.
+#[test]
+fn cie_xyz_sampled_equals_cie_xyz_bit_for_bit() {
+    use super::cie_xyz_sampled;
+    let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        300.0 + (rng >> 40) as f32 / (1u64 << 24) as f32 * 600.0
+    };
+    let mut cases: Vec<[f32; 4]> = (0..50_000)
+        .map(|_| [next(), next(), next(), next()])
+        .collect();
+    cases.push([LAMBDA_MIN, LAMBDA_MAX, LAMBDA_MIN - 1e-3, LAMBDA_MAX + 1e-3]);
+    cases.push([f32::NAN, 830.0f32.next_down(), 360.0f32.next_up(), 555.5]);
+    for lambda in cases {
+        let got = cie_xyz_sampled(&lambda);
+        for k in 0..4 {
+            let want = cie_xyz(lambda[k]);
+            let same = (0..3).all(|c| got[k][c].to_bits() == want[c].to_bits());
+            assert!(same, "λ {}: {:?} vs {:?}", lambda[k], got[k], want);
+        }
+    }
+}
