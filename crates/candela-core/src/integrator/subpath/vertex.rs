@@ -161,13 +161,25 @@ impl Vertex {
         let Some(bsdf) = &self.bsdf else {
             return SampledSpectrum::zero();
         };
-        let den = self.wo.dot(self.it.n).abs();
-        if den == 0.0 {
-            return SampledSpectrum::zero();
-        }
-        bsdf.f(self.wo, wi, TransportMode::Importance)
-            * (self.wo.dot(self.ns).abs() * wi.dot(self.it.n).abs() / den)
+        f_adjoint_cos(bsdf, &self.it, self.ns, self.wo, wi)
     }
+}
+
+/// [`Vertex::f_adjoint_cos`] of a surface point `it` with shading normal
+/// `ns`, BSDF `bsdf` and `wo` towards the previous light-subpath vertex.
+#[inline]
+pub fn f_adjoint_cos(
+    bsdf: &Bsdf,
+    it: &Interaction,
+    ns: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+) -> SampledSpectrum {
+    let den = wo.dot(it.n).abs();
+    if den == 0.0 {
+        return SampledSpectrum::zero();
+    }
+    bsdf.f(wo, wi, TransportMode::Importance) * (wo.dot(ns).abs() * wi.dot(it.n).abs() / den)
 }
 
 /// Unit direction from `from` towards `to` (handles vertices at infinity).

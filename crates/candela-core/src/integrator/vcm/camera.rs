@@ -303,33 +303,32 @@ impl CameraVisitor<'_, '_> {
     fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
         let max_depth = self.vcm.settings.max_depth;
         for lv in self.path {
-            if lv.v.depth + v.depth > max_depth {
+            if lv.depth + v.depth > max_depth {
                 break;
             }
-            let Some(lb) = &lv.v.bsdf else { continue };
-            let d = lv.v.p() - v.p();
+            let d = lv.p() - v.p();
             let d2 = d.length_squared();
             if d2 == 0.0 {
                 continue;
             }
             let w = d / d2.sqrt();
             let f_cam = cb.f(v.wo, w, TransportMode::Radiance) * w.dot(v.ns).abs();
-            let c = v.beta * f_cam * lv.v.f_adjoint_cos(-w) * lv.v.beta / d2;
+            let c = v.beta * f_cam * lv.f_adjoint_cos(-w) * lv.beta / d2;
             if c.is_black() {
                 continue;
             }
-            let all = SampleFlags::ALL;
+            let (lb, all) = (&lv.bsdf, SampleFlags::ALL);
             let cam_dir = cb.pdf(v.wo, w, TransportMode::Radiance, all).0;
             let cam_rev = cb.pdf(w, v.wo, TransportMode::Importance, all).0;
-            let light_dir = lb.pdf(lv.v.wo, -w, TransportMode::Importance, all).0;
-            let light_rev = lb.pdf(-w, lv.v.wo, TransportMode::Radiance, all).0;
-            let cam_dir_a = cam_dir * w.dot(lv.v.it.n).abs() / d2;
+            let light_dir = lb.pdf(lv.wo, -w, TransportMode::Importance, all).0;
+            let light_rev = lb.pdf(-w, lv.wo, TransportMode::Radiance, all).0;
+            let cam_dir_a = cam_dir * w.dot(lv.it.n).abs() / d2;
             let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
             let f = &self.cp.f;
             let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
             let w_cam = self.mis.connect_weight(light_dir_a, cam_rev, f);
             let mw = weight(w_light, w_cam);
-            if mw == 0.0 || !self.ctx.scene.unoccluded(&lv.v.it, &v.it) {
+            if mw == 0.0 || !self.ctx.scene.unoccluded(&lv.it, &v.it) {
                 continue;
             }
             self.l += unfold(c * mw, terminated, lv.terminated);

@@ -14,12 +14,12 @@
 
 use super::mis::{weight, Factors, Partial};
 use super::{Techniques, VcmIntegrator};
-use crate::bsdf::TransportMode;
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::SplatBuffer;
 use crate::integrator::driver::LANES;
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
-    start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
+    f_adjoint_cos, start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
 };
 use crate::integrator::RenderContext;
 use crate::interaction::{Interaction, LightId};
@@ -30,30 +30,69 @@ use crate::scene::Scene;
 use crate::spatial::HasPosition;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
+use std::sync::Mutex;
 
-/// A stored light-subpath vertex.
+/// A stored light-subpath vertex: what a connection reads of it (a
+/// [`Vertex`] also carries the walk's bookkeeping, which no join needs).
 #[derive(Clone, Copy, Debug)]
 pub struct LightVertex {
-    /// The vertex (position, normals, `wo`, BSDF, β, depth).
-    pub v: Vertex,
+    /// Position, error bound, geometric normal, time (for the shadow ray).
+    pub it: Interaction,
+    /// Shading normal.
+    pub ns: Vec3,
+    /// Unit direction towards the previous vertex (towards the light).
+    pub wo: Vec3,
+    /// The scattering function there.
+    pub bsdf: Bsdf,
+    /// The light subpath's throughput (power) at the vertex.
+    pub beta: SampledSpectrum,
     /// Its partial MIS quantities.
     pub mis: Partial,
+    /// Surface vertices of the light subpath up to this one.
+    pub depth: u32,
     /// Its subpath kept only the hero wavelength (dispersion, folded into β).
     pub terminated: bool,
 }
 
-impl HasPosition for LightVertex {
-    fn position(&self) -> Vec3 {
-        self.v.p()
+impl LightVertex {
+    /// Position.
+    #[inline]
+    pub fn p(&self) -> Vec3 {
+        self.it.p
+    }
+
+    /// f̂ towards `wi` with the adjoint shading-normal correction
+    /// ([`Vertex::f_adjoint_cos`]).
+    #[inline]
+    pub fn f_adjoint_cos(&self, wi: Vec3) -> SampledSpectrum {
+        f_adjoint_cos(&self.bsdf, &self.it, self.ns, self.wo, wi)
     }
 }
 
-/// The light subpaths of one iteration.
-pub struct LightPaths {
+impl HasPosition for LightVertex {
+    fn position(&self) -> Vec3 {
+        self.it.p
+    }
+}
+
+/// Light paths per chunk: the unit of parallel work of the light pass and
+/// of storage.
+pub(super) const CHUNK: usize = 4096;
+
+/// The stored vertices of [`CHUNK`] consecutive light paths.
+#[derive(Default)]
+pub(super) struct PathChunk {
     /// Every stored vertex, path after path, each path's in depth order.
-    pub vertices: Vec<LightVertex>,
-    /// Path i owns `vertices[start[i]..start[i + 1]]`.
-    pub start: Vec<u32>,
+    vertices: Vec<LightVertex>,
+    /// Path j of the chunk owns `vertices[ends[j - 1]..ends[j]]` (from 0 for j = 0).
+    ends: Vec<u32>,
+}
+
+/// The light subpaths of one iteration, kept in the chunks that made them
+/// (no copy into one array; their memory is reused by the next iteration
+/// through [`ChunkPool`]).
+pub struct LightPaths {
+    chunks: Vec<PathChunk>,
     /// The light-tracing splats (already scaled to one path per pixel).
     pub splats: Vec<SplatBuffer>,
 }
@@ -61,9 +100,61 @@ pub struct LightPaths {
 impl LightPaths {
     /// The vertices of path `i`.
     pub fn path(&self, i: usize) -> &[LightVertex] {
-        match (self.start.get(i), self.start.get(i + 1)) {
-            (Some(&a), Some(&b)) => &self.vertices[a as usize..b as usize],
-            _ => &[],
+        let Some(c) = self.chunks.get(i / CHUNK) else {
+            return &[];
+        };
+        let j = i % CHUNK;
+        let a = if j == 0 { 0 } else { c.ends[j - 1] as usize };
+        match c.ends.get(j) {
+            Some(&b) => &c.vertices[a..b as usize],
+            None => &[],
+        }
+    }
+
+    /// Every stored vertex, path after path.
+    pub fn vertices(&self) -> impl Iterator<Item = &LightVertex> {
+        self.chunks.iter().flat_map(|c| c.vertices.iter())
+    }
+
+    /// Number of stored vertices.
+    pub fn len(&self) -> usize {
+        self.chunks.iter().map(|c| c.vertices.len()).sum()
+    }
+
+    /// True when no vertex is stored.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Hands the chunks' memory back to `pool`.
+    pub(super) fn recycle(self, pool: &ChunkPool) {
+        pool.give(self.chunks);
+    }
+}
+
+/// Chunk buffers kept from one iteration to the next, so a pass does not
+/// allocate (and fault in) its vertex storage anew; the image never
+/// depends on it.
+#[derive(Default)]
+pub(super) struct ChunkPool(Mutex<Vec<PathChunk>>);
+
+impl ChunkPool {
+    /// An empty chunk, with the memory of an earlier one when there is one.
+    fn take(&self) -> PathChunk {
+        let mut c = self
+            .0
+            .lock()
+            .map(|mut p| p.pop())
+            .unwrap_or_default()
+            .unwrap_or_default();
+        c.vertices.clear();
+        c.ends.clear();
+        c
+    }
+
+    fn give(&self, chunks: Vec<PathChunk>) {
+        if let Ok(mut p) = self.0.lock() {
+            p.extend(chunks);
         }
     }
 }
@@ -97,11 +188,6 @@ pub fn light_densities(scene: &Scene, id: LightId, it: &Interaction, w: Vec3) ->
     (pmf * direct, pmf * pos * dir, cos)
 }
 
-/// Light paths per parallel chunk.
-const CHUNK: u64 = 4096;
-
-/// What one chunk of paths made.
-type Chunk = (u64, Vec<LightVertex>, Vec<u32>);
 
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
@@ -115,8 +201,9 @@ impl VcmIntegrator {
         f: &Factors,
     ) -> Option<LightPaths> {
         let n = self.light_paths(ctx);
-        let n_chunks = n.div_ceil(CHUNK);
-        let lanes: Vec<(SplatBuffer, Vec<Chunk>)> = (0..LANES as u64)
+        let chunk = CHUNK as u64;
+        let n_chunks = n.div_ceil(chunk);
+        let lanes: Vec<(SplatBuffer, Vec<(u64, PathChunk)>)> = (0..LANES as u64)
             .into_par_iter()
             .map(|lane| {
                 let mut buf = ctx.film.splat_buffer();
@@ -125,15 +212,14 @@ impl VcmIntegrator {
                     if ctx.cancelled() {
                         break;
                     }
-                    let (mut verts, mut lens) = (Vec::new(), Vec::new());
-                    let end = ((c + 1) * CHUNK).min(n);
-                    for i in c * CHUNK..end {
-                        let before = verts.len();
-                        self.trace_light(ctx, pass, i, lambda, time, f, &mut verts, &mut buf);
-                        lens.push((verts.len() - before) as u32);
+                    let mut out = self.pool.take();
+                    let end = ((c + 1) * chunk).min(n);
+                    for i in c * chunk..end {
+                        self.trace_light(ctx, pass, i, lambda, time, f, &mut out.vertices, &mut buf);
+                        out.ends.push(out.vertices.len() as u32);
                     }
-                    ctx.advance(end - c * CHUNK);
-                    chunks.push((c, verts, lens));
+                    ctx.advance(end - c * chunk);
+                    chunks.push((c, out));
                 }
                 (buf, chunks)
             })
@@ -148,19 +234,10 @@ impl VcmIntegrator {
             chunks.extend(c);
         }
         chunks.sort_by_key(|c| c.0);
-        let mut out = LightPaths {
-            vertices: Vec::new(),
-            start: vec![0],
+        Some(LightPaths {
+            chunks: chunks.into_iter().map(|(_, c)| c).collect(),
             splats,
-        };
-        for (_, verts, lens) in chunks {
-            out.vertices.extend(verts);
-            for l in lens {
-                let last = *out.start.last().unwrap_or(&0);
-                out.start.push(last + l);
-            }
-        }
-        Some(out)
+        })
     }
 
     /// Walks light path `i`, storing its vertices in `out` and splatting its
@@ -285,8 +362,13 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
         let t: &Techniques = &self.vcm.techniques;
         if t.connect || t.merge {
             self.out.push(LightVertex {
-                v: *v,
+                it: v.it,
+                ns: v.ns,
+                wo: v.wo,
+                bsdf: *bsdf,
+                beta: v.beta,
                 mis: self.mis,
+                depth: v.depth,
                 terminated: lam.secondary_terminated(),
             });
         }

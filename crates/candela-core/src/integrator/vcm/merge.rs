@@ -14,11 +14,11 @@
 //! on the Cornell box at 128² that load alone was 18 % of a VCM iteration
 //! (`perf annotate`, the merge loop was 39 % of it).
 
-use super::light::LightVertex;
+use super::light::{LightPaths, LightVertex};
 use super::mis::Partial;
 use crate::integrator::gather::Surfel;
 use crate::math::Vec3;
-use crate::spatial::HashGrid;
+use crate::spatial::{HasPosition, HashGrid};
 use crate::spectrum::SampledSpectrum;
 
 /// Bytes a merging iteration adds per stored vertex: its photon, and the
@@ -45,15 +45,21 @@ impl Photon {
     fn new(lv: &LightVertex) -> Self {
         Photon {
             surfel: Surfel {
-                p: lv.v.p(),
-                n: lv.v.it.n,
-                w: lv.v.wo,
+                p: lv.it.p,
+                n: lv.it.n,
+                w: lv.wo,
             },
-            beta: lv.v.beta,
+            beta: lv.beta,
             mis: lv.mis,
-            depth: lv.v.depth,
+            depth: lv.depth,
             terminated: lv.terminated,
         }
+    }
+}
+
+impl HasPosition for Photon {
+    fn position(&self) -> Vec3 {
+        self.surfel.p
     }
 }
 
@@ -65,13 +71,14 @@ pub(super) struct MergeGrid {
 }
 
 impl MergeGrid {
-    /// The grid for merge radius `radius` over `vertices`.
-    pub fn build(vertices: &[LightVertex], radius: f32) -> Self {
-        let grid = HashGrid::build(vertices, radius);
+    /// The grid for merge radius `radius` over the stored vertices of `light`.
+    pub fn build(light: &LightPaths, radius: f32) -> Self {
+        let photons: Vec<Photon> = light.vertices().map(Photon::new).collect();
+        let grid = HashGrid::build(&photons, radius);
         let photons = grid
             .entry_order()
             .iter()
-            .map(|&i| Photon::new(&vertices[i as usize]))
+            .map(|&i| photons[i as usize])
             .collect();
         MergeGrid { grid, photons }
     }

@@ -183,6 +183,8 @@ pub struct VcmIntegrator {
     /// Light vertices the last finished light pass stored (for the status
     /// line only; the image never depends on it).
     stored: AtomicU64,
+    /// Vertex storage reused from one iteration to the next.
+    pool: light::ChunkPool,
 }
 
 impl VcmIntegrator {
@@ -193,6 +195,7 @@ impl VcmIntegrator {
             settings,
             techniques,
             stored: AtomicU64::new(0),
+            pool: light::ChunkPool::default(),
         }
     }
 
@@ -273,16 +276,16 @@ impl Integrator for VcmIntegrator {
         let Some(light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
             return PassOutcome::Cancelled;
         };
-        self.stored
-            .store(light.vertices.len() as u64, Ordering::Relaxed);
+        self.stored.store(light.len() as u64, Ordering::Relaxed);
         for b in &light.splats {
             block.add_splats(b);
         }
         if t.light_only {
+            light.recycle(&self.pool);
             return PassOutcome::Done;
         }
-        let grid = (t.merge && !light.vertices.is_empty() && radius > 0.0)
-            .then(|| merge::MergeGrid::build(&light.vertices, radius));
+        let grid = (t.merge && !light.is_empty() && radius > 0.0)
+            .then(|| merge::MergeGrid::build(&light, radius));
         let cp = CameraPass {
             light: &light,
             grid: grid.as_ref(),
@@ -292,11 +295,13 @@ impl Integrator for VcmIntegrator {
             time,
             pass,
         };
-        let Some(tiles) = for_each_tile(ctx, |lo, hi| {
+        let tiles = for_each_tile(ctx, |lo, hi| {
             let tile = self.camera_tile(ctx, &cp, lo, hi);
             ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
             tile
-        }) else {
+        });
+        light.recycle(&self.pool);
+        let Some(tiles) = tiles else {
             return PassOutcome::Cancelled;
         };
         for tile in &tiles {
