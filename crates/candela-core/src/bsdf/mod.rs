@@ -156,6 +156,17 @@ impl BsdfSample {
     }
 }
 
+/// f and both densities of one pair of directions ([`Bsdf::eval`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfEval {
+    /// f(wo, wi) (cosine excluded).
+    pub f: SampledSpectrum,
+    /// Density of sampling `wi` given `wo` in the given mode.
+    pub pdf_fwd: PdfSolidAngle,
+    /// Density of sampling `wo` given `wi` in the adjoint mode.
+    pub pdf_rev: PdfSolidAngle,
+}
+
 /// The closed set of local-frame scattering models.
 #[derive(Clone, Copy, Debug)]
 pub enum Bxdf {
@@ -369,6 +380,29 @@ impl Bsdf {
             return PdfSolidAngle(0.0);
         }
         self.bxdf.pdf(wo, wi, mode, allowed)
+    }
+    /// f(wo, wi) in `mode` with the forward density `pdf(wo, wi, mode)` and
+    /// the reverse one `pdf(wi, wo, mode.adjoint())` (all lobes), the values
+    /// [`Self::f`] and [`Self::pdf`] give, from one frame change per
+    /// direction: what a bidirectional join needs at each end.
+    pub fn eval(&self, wo_render: Vec3, wi_render: Vec3, mode: TransportMode) -> BsdfEval {
+        let (wo, wi) = (self.to_local(wo_render), self.to_local(wi_render));
+        let all = SampleFlags::ALL;
+        let (f, pdf_fwd) = if wo.z == 0.0 {
+            (SampledSpectrum::zero(), PdfSolidAngle(0.0))
+        } else {
+            (self.bxdf.f(wo, wi, mode), self.bxdf.pdf(wo, wi, mode, all))
+        };
+        let pdf_rev = if wi.z == 0.0 {
+            PdfSolidAngle(0.0)
+        } else {
+            self.bxdf.pdf(wi, wo, mode.adjoint(), all)
+        };
+        BsdfEval {
+            f,
+            pdf_fwd,
+            pdf_rev,
+        }
     }
     /// Applies path regularisation.
     pub fn regularize(&mut self) {

@@ -22,8 +22,9 @@
 use super::light::{light_densities, LightPaths, LightVertex};
 use super::merge::MergeGrid;
 use super::mis::{weight, Factors, Partial};
-use super::VcmIntegrator;
-use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
+use super::resample::Resampler;
+use super::{Connections, VcmIntegrator};
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::FilmTile;
 use crate::integrator::driver::camera_sample;
 use crate::integrator::gather::{gather, Surfel};
@@ -36,6 +37,7 @@ use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
+use crate::sampling::PathRng;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// What the camera pass of one iteration shares.
@@ -189,7 +191,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
         let terminated = lambda.secondary_terminated();
         if t.connect {
             self.next_event(v, bsdf, lambda, rng);
-            self.connect(v, bsdf, terminated);
+            self.connect(v, bsdf, terminated, rng);
         }
         if t.merge {
             self.merge(v, bsdf, terminated);
@@ -278,15 +280,13 @@ impl CameraVisitor<'_, '_> {
         if direct <= 0.0 {
             return;
         }
+        let pdfs = bsdf.eval(v.wo, ls.wi, TransportMode::Radiance);
         let bsdf_dir = if light.is_hittable() {
-            bsdf.pdf(v.wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
-                .0
+            pdfs.pdf_fwd.0
         } else {
             0.0
         };
-        let bsdf_rev = bsdf
-            .pdf(ls.wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
-            .0;
+        let bsdf_rev = pdfs.pdf_rev.0;
         let cos_recv = ls.wi.dot(v.it.n).abs();
         let inv_d2 = if e.at_infinity() {
             1.0
@@ -299,40 +299,70 @@ impl CameraVisitor<'_, '_> {
         self.l += v.beta * ls.unweighted() * weight(w_light, w_cam);
     }
 
-    /// Connections to the vertices of the pixel's light subpath [eqs. 40–41].
-    fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
+    /// Connections to the vertices of the pixel's light subpath [eqs.
+    /// 40–41]: to every one, or to one resampled in proportion to its
+    /// unoccluded contribution ([`Connections`], module doc of [`super`]).
+    fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool, rng: &mut Sampler) {
         let max_depth = self.vcm.settings.max_depth;
-        for lv in self.path {
-            if lv.depth + v.depth > max_depth {
-                break;
+        let path = self.path;
+        let joinable = path.iter().take_while(|lv| lv.depth + v.depth <= max_depth);
+        let scene = self.ctx.scene;
+        match self.vcm.settings.connections {
+            Connections::All => {
+                for lv in joinable {
+                    let Some(x) = self.connection(v, cb, lv, terminated) else {
+                        continue;
+                    };
+                    if scene.unoccluded(&lv.it, &v.it) {
+                        self.l += x;
+                    }
+                }
             }
-            let d = lv.p() - v.p();
-            let d2 = d.length_squared();
-            if d2 == 0.0 {
-                continue;
+            Connections::One => {
+                let mut r = Resampler::new(rng.u1());
+                for lv in joinable {
+                    if let Some(x) = self.connection(v, cb, lv, terminated) {
+                        r.offer((lv, x), x.average());
+                    }
+                }
+                if let Some(((lv, x), inv_p)) = r.pick() {
+                    if scene.unoccluded(&lv.it, &v.it) {
+                        self.l += x * inv_p;
+                    }
+                }
             }
-            let w = d / d2.sqrt();
-            let f_cam = cb.f(v.wo, w, TransportMode::Radiance) * w.dot(v.ns).abs();
-            let c = v.beta * f_cam * lv.f_adjoint_cos(-w) * lv.beta / d2;
-            if c.is_black() {
-                continue;
-            }
-            let (lb, all) = (&lv.bsdf, SampleFlags::ALL);
-            let cam_dir = cb.pdf(v.wo, w, TransportMode::Radiance, all).0;
-            let cam_rev = cb.pdf(w, v.wo, TransportMode::Importance, all).0;
-            let light_dir = lb.pdf(lv.wo, -w, TransportMode::Importance, all).0;
-            let light_rev = lb.pdf(-w, lv.wo, TransportMode::Radiance, all).0;
-            let cam_dir_a = cam_dir * w.dot(lv.it.n).abs() / d2;
-            let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
-            let f = &self.cp.f;
-            let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
-            let w_cam = self.mis.connect_weight(light_dir_a, cam_rev, f);
-            let mw = weight(w_light, w_cam);
-            if mw == 0.0 || !self.ctx.scene.unoccluded(&lv.it, &v.it) {
-                continue;
-            }
-            self.l += unfold(c * mw, terminated, lv.terminated);
         }
+    }
+
+    /// The MIS-weighted contribution of joining `v` to light vertex `lv`
+    /// if nothing lies between them [eqs. 40–41]; `None` when it is zero.
+    fn connection(
+        &self,
+        v: &Vertex,
+        cb: &Bsdf,
+        lv: &LightVertex,
+        terminated: bool,
+    ) -> Option<SampledSpectrum> {
+        let d = lv.p() - v.p();
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let w = d / d2.sqrt();
+        let cam = cb.eval(v.wo, w, TransportMode::Radiance);
+        let (f_light, light_dir, light_rev) = lv.eval(-w);
+        let f_cam = cam.f * w.dot(v.ns).abs();
+        let c = v.beta * f_cam * f_light * lv.beta / d2;
+        if c.is_black() {
+            return None;
+        }
+        let cam_dir_a = cam.pdf_fwd.0 * w.dot(lv.it.n).abs() / d2;
+        let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
+        let f = &self.cp.f;
+        let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
+        let w_cam = self.mis.connect_weight(light_dir_a, cam.pdf_rev.0, f);
+        let mw = weight(w_light, w_cam);
+        (mw != 0.0).then(|| unfold(c * mw, terminated, lv.terminated))
     }
 
     /// Merges with the iteration's light vertices around `v` [eqs. 38–39].
@@ -354,25 +384,16 @@ impl CameraVisitor<'_, '_> {
             let Some(c) = gather(&x, &ph.surfel, r2) else {
                 return;
             };
-            let wi = c.wi;
-            let fv = cb.f(v.wo, wi, TransportMode::Radiance);
+            let (fv, w) = if ppm {
+                (cb.f(v.wo, c.wi, TransportMode::Radiance), 1.0)
+            } else {
+                let e = cb.eval(v.wo, c.wi, TransportMode::Radiance);
+                let w_light = ph.mis.merge_weight(e.pdf_fwd.0, f);
+                (e.f, weight(w_light, self.mis.merge_weight(e.pdf_rev.0, f)))
+            };
             if fv.is_black() {
                 return;
             }
-            let w = if ppm {
-                1.0
-            } else {
-                let cam_dir = cb
-                    .pdf(v.wo, wi, TransportMode::Radiance, SampleFlags::ALL)
-                    .0;
-                let cam_rev = cb
-                    .pdf(wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
-                    .0;
-                weight(
-                    ph.mis.merge_weight(cam_dir, f),
-                    self.mis.merge_weight(cam_rev, f),
-                )
-            };
             sum += unfold(fv * ph.beta * w, terminated, ph.terminated);
         });
         self.l += v.beta * sum * f.merge_norm;

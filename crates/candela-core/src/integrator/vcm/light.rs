@@ -19,7 +19,7 @@ use crate::film::SplatBuffer;
 use crate::integrator::driver::LANES;
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
-    f_adjoint_cos, start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
+    adjoint_cos, start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
 };
 use crate::integrator::RenderContext;
 use crate::interaction::{Interaction, LightId};
@@ -62,10 +62,17 @@ impl LightVertex {
     }
 
     /// f̂ towards `wi` with the adjoint shading-normal correction
-    /// ([`Vertex::f_adjoint_cos`]).
+    /// ([`Vertex::f_adjoint_cos`]), the density of scattering towards `wi`
+    /// (importance) and that of scattering back towards `wo` from `wi`
+    /// (radiance): one end of a connection [eqs. 40–41].
     #[inline]
-    pub fn f_adjoint_cos(&self, wi: Vec3) -> SampledSpectrum {
-        f_adjoint_cos(&self.bsdf, &self.it, self.ns, self.wo, wi)
+    pub fn eval(&self, wi: Vec3) -> (SampledSpectrum, f32, f32) {
+        let e = self.bsdf.eval(self.wo, wi, TransportMode::Importance);
+        let f = match adjoint_cos(&self.it, self.ns, self.wo, wi) {
+            Some(k) => e.f * k,
+            None => SampledSpectrum::zero(),
+        };
+        (f, e.pdf_fwd.0, e.pdf_rev.0)
     }
 }
 
@@ -188,7 +195,6 @@ pub fn light_densities(scene: &Scene, id: LightId, it: &Interaction, w: Vec3) ->
     (pmf * direct, pmf * pos * dir, cos)
 }
 
-
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
     /// `lambda` and time `time`; `None` if the render was cancelled.
@@ -215,7 +221,16 @@ impl VcmIntegrator {
                     let mut out = self.pool.take();
                     let end = ((c + 1) * chunk).min(n);
                     for i in c * chunk..end {
-                        self.trace_light(ctx, pass, i, lambda, time, f, &mut out.vertices, &mut buf);
+                        self.trace_light(
+                            ctx,
+                            pass,
+                            i,
+                            lambda,
+                            time,
+                            f,
+                            &mut out.vertices,
+                            &mut buf,
+                        );
                         out.ends.push(out.vertices.len() as u32);
                     }
                     ctx.advance(end - c * chunk);
