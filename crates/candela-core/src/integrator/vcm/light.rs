@@ -118,9 +118,9 @@ impl LightPaths {
         }
     }
 
-    /// Every stored vertex, path after path.
-    pub fn vertices(&self) -> impl Iterator<Item = &LightVertex> {
-        self.chunks.iter().flat_map(|c| c.vertices.iter())
+    /// Every stored vertex, path after path, chunk by chunk.
+    pub fn chunks(&self) -> Vec<&[LightVertex]> {
+        self.chunks.iter().map(|c| c.vertices.as_slice()).collect()
     }
 
     /// Number of stored vertices.

@@ -20,6 +20,7 @@ use crate::integrator::gather::Surfel;
 use crate::math::Vec3;
 use crate::spatial::{HasPosition, HashGrid};
 use crate::spectrum::SampledSpectrum;
+use rayon::prelude::*;
 
 /// Bytes a merging iteration adds per stored vertex: its photon, and the
 /// grid's position, index and (about one per vertex) bucket start.
@@ -72,12 +73,18 @@ pub(super) struct MergeGrid {
 
 impl MergeGrid {
     /// The grid for merge radius `radius` over the stored vertices of `light`.
+    /// The photons are made and reordered in parallel; only the grid's
+    /// counting sort is serial.
     pub fn build(light: &LightPaths, radius: f32) -> Self {
-        let photons: Vec<Photon> = light.vertices().map(Photon::new).collect();
+        let photons: Vec<Photon> = light
+            .chunks()
+            .par_iter()
+            .flat_map_iter(|c| c.iter().map(Photon::new))
+            .collect();
         let grid = HashGrid::build(&photons, radius);
         let photons = grid
             .entry_order()
-            .iter()
+            .par_iter()
             .map(|&i| photons[i as usize])
             .collect();
         MergeGrid { grid, photons }
