@@ -105,7 +105,8 @@ impl VcmIntegrator {
             },
             SampledSpectrum::splat(ray_weight),
         );
-        let pdf_pixel = self.pixel_density(ctx, &ray);
+        let pdf_dir = ctx.camera.pdf_we(&ray).1;
+        let pdf_pixel = self.pixel_density(pdf_dir, ctx);
         let n_light = self.light_paths(ctx) as f32;
         let mut v = CameraVisitor {
             vcm: self,
@@ -131,7 +132,7 @@ impl VcmIntegrator {
             beta: SampledSpectrum::splat(ray_weight),
             depth: 0,
             from: Some(lens),
-            pdf_dir: ctx.camera.pdf_we(&ray).1,
+            pdf_dir,
         };
         let mut lambda = cp.lambda;
         walk(ctx.scene, &mut lambda, sampler, &w, start, &mut v);

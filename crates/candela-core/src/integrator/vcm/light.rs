@@ -421,7 +421,8 @@ impl LightVisitor<'_, '_> {
             1.0
         } else {
             let d2 = (cs.p_lens.p - v.p()).length_squared();
-            let pdf_pixel = self.vcm.pixel_density(ctx, &Ray::new(cs.p_lens.p, -cs.wi));
+            let pdf_dir = ctx.camera.pdf_we(&Ray::new(cs.p_lens.p, -cs.wi)).1;
+            let pdf_pixel = self.vcm.pixel_density(pdf_dir, ctx);
             let n_light = self.vcm.light_paths(ctx) as f32;
             let pdf_cam_a = pdf_pixel * cs.wi.dot(v.it.n).abs() / (d2 * n_light);
             let pdf_rev = v.bsdf.as_ref().map_or(0.0, |b| {

@@ -93,7 +93,7 @@ use crate::film::PassBlock;
 use crate::integrator::driver::for_each_tile;
 use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::sppm::ppm_radius2;
-use crate::math::Ray;
+use crate::sampling::PdfSolidAngle;
 use crate::sampling::hash_u64s;
 use camera::CameraPass;
 use light::LightVertex;
@@ -274,10 +274,11 @@ impl VcmIntegrator {
         (r0 * r0 * ppm_radius2(pass + 1, self.settings.alpha as f64)).sqrt() as f32
     }
 
-    /// Solid-angle density of camera ray `ray` per unit pixel area (the
-    /// camera's film-normalised density times the full film's pixel count).
-    fn pixel_density(&self, ctx: &RenderContext<'_>, ray: &Ray) -> f32 {
-        ctx.camera.pdf_we(ray).1 .0 * full_pixels(ctx) as f32
+    /// Solid-angle density per unit pixel area of a camera ray whose
+    /// film-normalised direction density is `pdf_dir` (times the full
+    /// film's pixel count).
+    fn pixel_density(&self, pdf_dir: PdfSolidAngle, ctx: &RenderContext<'_>) -> f32 {
+        pdf_dir.0 * full_pixels(ctx) as f32
     }
 
     /// Factor of light-tracing splats: the film counts one light path per
