@@ -156,15 +156,14 @@ impl BsdfSample {
     }
 }
 
-/// f and both densities of one pair of directions ([`Bsdf::eval`]).
+/// A pair of world directions taken into a BSDF's local frame once
+/// ([`Bsdf::local_pair`]), so f and both densities of the pair are
+/// evaluated without repeating the frame change: what a bidirectional join
+/// needs at each end.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BsdfEval {
-    /// f(wo, wi) (cosine excluded).
-    pub f: SampledSpectrum,
-    /// Density of sampling `wi` given `wo` in the given mode.
-    pub pdf_fwd: PdfSolidAngle,
-    /// Density of sampling `wo` given `wi` in the adjoint mode.
-    pub pdf_rev: PdfSolidAngle,
+pub struct LocalPair {
+    wo: Vec3,
+    wi: Vec3,
 }
 
 /// The closed set of local-frame scattering models.
@@ -381,28 +380,38 @@ impl Bsdf {
         }
         self.bxdf.pdf(wo, wi, mode, allowed)
     }
-    /// f(wo, wi) in `mode` with the forward density `pdf(wo, wi, mode)` and
-    /// the reverse one `pdf(wi, wo, mode.adjoint())` (all lobes), the values
-    /// [`Self::f`] and [`Self::pdf`] give, from one frame change per
-    /// direction: what a bidirectional join needs at each end.
-    pub fn eval(&self, wo_render: Vec3, wi_render: Vec3, mode: TransportMode) -> BsdfEval {
-        let (wo, wi) = (self.to_local(wo_render), self.to_local(wi_render));
+    /// `wo` and `wi` (world space) in the local frame.
+    #[inline]
+    pub fn local_pair(&self, wo_render: Vec3, wi_render: Vec3) -> LocalPair {
+        LocalPair {
+            wo: self.to_local(wo_render),
+            wi: self.to_local(wi_render),
+        }
+    }
+    /// [`Self::f`] of the pair.
+    #[inline]
+    pub fn f_pair(&self, d: &LocalPair, mode: TransportMode) -> SampledSpectrum {
+        if d.wo.z == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        self.bxdf.f(d.wo, d.wi, mode)
+    }
+    /// The densities [`Self::pdf`] gives the pair, all lobes: forward,
+    /// `pdf(wo, wi, mode)`, and reverse, `pdf(wi, wo, mode.adjoint())`.
+    #[inline]
+    pub fn pdfs_pair(&self, d: &LocalPair, mode: TransportMode) -> (PdfSolidAngle, PdfSolidAngle) {
         let all = SampleFlags::ALL;
-        let (f, pdf_fwd) = if wo.z == 0.0 {
-            (SampledSpectrum::zero(), PdfSolidAngle(0.0))
-        } else {
-            (self.bxdf.f(wo, wi, mode), self.bxdf.pdf(wo, wi, mode, all))
-        };
-        let pdf_rev = if wi.z == 0.0 {
+        let fwd = if d.wo.z == 0.0 {
             PdfSolidAngle(0.0)
         } else {
-            self.bxdf.pdf(wi, wo, mode.adjoint(), all)
+            self.bxdf.pdf(d.wo, d.wi, mode, all)
         };
-        BsdfEval {
-            f,
-            pdf_fwd,
-            pdf_rev,
-        }
+        let rev = if d.wi.z == 0.0 {
+            PdfSolidAngle(0.0)
+        } else {
+            self.bxdf.pdf(d.wi, d.wo, mode.adjoint(), all)
+        };
+        (fwd, rev)
     }
     /// Applies path regularisation.
     pub fn regularize(&mut self) {

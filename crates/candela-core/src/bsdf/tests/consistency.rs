@@ -138,11 +138,11 @@ fn sampled_values_follow_mode_scaling() {
 }
 
 #[test]
-fn bsdf_eval_equals_f_and_both_pdfs_bit_for_bit() {
-    // `Bsdf::eval` is an evaluation-order shortcut for bidirectional joins:
-    // it must return exactly what `f`, `pdf` and the adjoint `pdf` return,
-    // in a tilted frame, in both modes, including directions at (or within
-    // rounding of) the shading plane.
+fn local_pair_evaluation_equals_f_and_both_pdfs_bit_for_bit() {
+    // `Bsdf::local_pair` with `f_pair` and `pdfs_pair` is an evaluation-order
+    // shortcut for bidirectional joins: it must return exactly what `f`,
+    // `pdf` and the adjoint `pdf` return, in a tilted frame, in both modes,
+    // including directions at (or within rounding of) the shading plane.
     let frame_n = Vec3::new(0.3, 0.8, -0.52).normalize();
     let tangent = Vec3::new(1.0, -0.2, 0.27);
     let mut checked = 0;
@@ -157,18 +157,22 @@ fn bsdf_eval_equals_f_and_both_pdfs_bit_for_bit() {
                 sample_uniform_sphere(u2(&mut r))
             };
             for mode in MODES {
-                let e = bsdf.eval(wo, wi, mode);
+                let pair = bsdf.local_pair(wo, wi);
+                let f_pair = bsdf.f_pair(&pair, mode);
+                let (fwd_pair, rev_pair) = bsdf.pdfs_pair(&pair, mode);
                 let f = bsdf.f(wo, wi, mode);
                 let fwd = bsdf.pdf(wo, wi, mode, SampleFlags::ALL);
                 let rev = bsdf.pdf(wi, wo, mode.adjoint(), SampleFlags::ALL);
                 assert!(
-                    e.f.0
+                    f_pair
+                        .0
                         .iter()
                         .zip(&f.0)
                         .all(|(a, b)| a.to_bits() == b.to_bits())
-                        && e.pdf_fwd.0.to_bits() == fwd.0.to_bits()
-                        && e.pdf_rev.0.to_bits() == rev.0.to_bits(),
-                    "{} {mode:?} wo={wo} wi={wi}: {e:?} vs {f:?} {fwd:?} {rev:?}",
+                        && fwd_pair.0.to_bits() == fwd.0.to_bits()
+                        && rev_pair.0.to_bits() == rev.0.to_bits(),
+                    "{} {mode:?} wo={wo} wi={wi}: {f_pair:?} {fwd_pair:?} {rev_pair:?} vs \
+                     {f:?} {fwd:?} {rev:?}",
                     case.name
                 );
                 checked += usize::from(!f.is_black() && fwd.0 > 0.0 && rev.0 > 0.0);

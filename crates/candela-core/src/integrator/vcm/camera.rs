@@ -24,7 +24,7 @@ use super::merge::MergeGrid;
 use super::mis::{weight, Factors, Partial};
 use super::resample::Resampler;
 use super::{Connections, VcmIntegrator};
-use crate::bsdf::{Bsdf, TransportMode};
+use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::film::FilmTile;
 use crate::integrator::driver::camera_sample;
 use crate::integrator::gather::{gather, Surfel};
@@ -281,13 +281,15 @@ impl CameraVisitor<'_, '_> {
         if direct <= 0.0 {
             return;
         }
-        let pdfs = bsdf.eval(v.wo, ls.wi, TransportMode::Radiance);
         let bsdf_dir = if light.is_hittable() {
-            pdfs.pdf_fwd.0
+            bsdf.pdf(v.wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
+                .0
         } else {
             0.0
         };
-        let bsdf_rev = pdfs.pdf_rev.0;
+        let bsdf_rev = bsdf
+            .pdf(ls.wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
+            .0;
         let cos_recv = ls.wi.dot(v.it.n).abs();
         let inv_d2 = if e.at_infinity() {
             1.0
@@ -350,18 +352,20 @@ impl CameraVisitor<'_, '_> {
             return None;
         }
         let w = d / d2.sqrt();
-        let cam = cb.eval(v.wo, w, TransportMode::Radiance);
-        let (f_light, light_dir, light_rev) = lv.eval(-w);
-        let f_cam = cam.f * w.dot(v.ns).abs();
+        let cam = cb.local_pair(v.wo, w);
+        let f_cam = cb.f_pair(&cam, TransportMode::Radiance) * w.dot(v.ns).abs();
+        let (f_light, light) = lv.f_adjoint_cos(-w);
         let c = v.beta * f_cam * f_light * lv.beta / d2;
         if c.is_black() {
             return None;
         }
-        let cam_dir_a = cam.pdf_fwd.0 * w.dot(lv.it.n).abs() / d2;
+        let (cam_dir, cam_rev) = cb.pdfs_pair(&cam, TransportMode::Radiance);
+        let (light_dir, light_rev) = lv.pdfs(&light);
+        let cam_dir_a = cam_dir.0 * w.dot(lv.it.n).abs() / d2;
         let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
         let f = &self.cp.f;
         let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
-        let w_cam = self.mis.connect_weight(light_dir_a, cam.pdf_rev.0, f);
+        let w_cam = self.mis.connect_weight(light_dir_a, cam_rev.0, f);
         let mw = weight(w_light, w_cam);
         (mw != 0.0).then(|| unfold(c * mw, terminated, lv.terminated))
     }
@@ -385,16 +389,20 @@ impl CameraVisitor<'_, '_> {
             let Some(c) = gather(&x, &ph.surfel, r2) else {
                 return;
             };
-            let (fv, w) = if ppm {
-                (cb.f(v.wo, c.wi, TransportMode::Radiance), 1.0)
-            } else {
-                let e = cb.eval(v.wo, c.wi, TransportMode::Radiance);
-                let w_light = ph.mis.merge_weight(e.pdf_fwd.0, f);
-                (e.f, weight(w_light, self.mis.merge_weight(e.pdf_rev.0, f)))
-            };
+            let pair = cb.local_pair(v.wo, c.wi);
+            let fv = cb.f_pair(&pair, TransportMode::Radiance);
             if fv.is_black() {
                 return;
             }
+            let w = if ppm {
+                1.0
+            } else {
+                let (cam_dir, cam_rev) = cb.pdfs_pair(&pair, TransportMode::Radiance);
+                weight(
+                    ph.mis.merge_weight(cam_dir.0, f),
+                    self.mis.merge_weight(cam_rev.0, f),
+                )
+            };
             sum += unfold(fv * ph.beta * w, terminated, ph.terminated);
         });
         self.l += v.beta * sum * f.merge_norm;

@@ -14,7 +14,7 @@
 
 use super::mis::{weight, Factors, Partial};
 use super::{Techniques, VcmIntegrator};
-use crate::bsdf::{Bsdf, TransportMode};
+use crate::bsdf::{Bsdf, LocalPair, TransportMode};
 use crate::film::SplatBuffer;
 use crate::integrator::driver::LANES;
 use crate::integrator::roulette::Roulette;
@@ -62,17 +62,25 @@ impl LightVertex {
     }
 
     /// f̂ towards `wi` with the adjoint shading-normal correction
-    /// ([`Vertex::f_adjoint_cos`]), the density of scattering towards `wi`
-    /// (importance) and that of scattering back towards `wo` from `wi`
-    /// (radiance): one end of a connection [eqs. 40–41].
+    /// ([`Vertex::f_adjoint_cos`]) and the frame-local pair of directions
+    /// it was evaluated for (for [`LightVertex::pdfs`]).
     #[inline]
-    pub fn eval(&self, wi: Vec3) -> (SampledSpectrum, f32, f32) {
-        let e = self.bsdf.eval(self.wo, wi, TransportMode::Importance);
+    pub fn f_adjoint_cos(&self, wi: Vec3) -> (SampledSpectrum, LocalPair) {
+        let pair = self.bsdf.local_pair(self.wo, wi);
         let f = match adjoint_cos(&self.it, self.ns, self.wo, wi) {
-            Some(k) => e.f * k,
+            Some(k) => self.bsdf.f_pair(&pair, TransportMode::Importance) * k,
             None => SampledSpectrum::zero(),
         };
-        (f, e.pdf_fwd.0, e.pdf_rev.0)
+        (f, pair)
+    }
+
+    /// The densities of scattering along `pair` (importance, towards `wi`)
+    /// and back (radiance, towards `wo`): one end of a connection's weight
+    /// [eqs. 40–41].
+    #[inline]
+    pub fn pdfs(&self, pair: &LocalPair) -> (f32, f32) {
+        let (fwd, rev) = self.bsdf.pdfs_pair(pair, TransportMode::Importance);
+        (fwd.0, rev.0)
     }
 }
 
