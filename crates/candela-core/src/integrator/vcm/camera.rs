@@ -19,7 +19,7 @@
 //! with the film's filter weight to a [`FilmTile`], so the camera side
 //! filters exactly as the path tracer does.
 
-use super::light::{light_densities, LightPaths, LightVertex};
+use super::light::{light_densities, LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
 use super::mis::{weight, Factors, Partial};
 use super::resample::Resampler;
@@ -114,7 +114,7 @@ impl VcmIntegrator {
             cp,
             path,
             mis: Partial::camera(pdf_pixel, n_light, ctx.camera.is_connectable()),
-            prev: lens,
+            prev: PrevVertex::of(&lens),
             pending: None,
             specular: true,
             vertices: 0,
@@ -147,7 +147,7 @@ struct CameraVisitor<'a, 'b> {
     cp: &'a CameraPass<'a>,
     path: &'a [LightVertex],
     mis: Partial,
-    prev: Vertex,
+    prev: PrevVertex,
     pending: Option<Scatter>,
     /// Every scattering so far was a delta.
     specular: bool,
@@ -172,13 +172,13 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
 
     fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut Sampler) -> Flow {
         if let Some(s) = self.pending.take() {
-            let cos_out = v.wo.dot(self.prev.it.n).abs();
+            let cos_out = v.wo.dot(self.prev.n).abs();
             self.mis
                 .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
         }
-        let d2 = (v.p() - self.prev.p()).length_squared();
+        let d2 = (v.p() - self.prev.p).length_squared();
         self.mis.hit(d2, v.wo.dot(v.it.n).abs());
-        self.prev = *v;
+        self.prev = PrevVertex::of(v);
         self.vertices += 1;
         self.emission(v, lambda);
         let max_depth = self.vcm.settings.max_depth;
@@ -210,7 +210,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
         if let Some(s) = self.pending.take() {
-            let cos_out = e.ray.d.normalize().dot(self.prev.it.n).abs();
+            let cos_out = e.ray.d.normalize().dot(self.prev.n).abs();
             self.mis
                 .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
         }
@@ -221,7 +221,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
                 continue;
             }
             let w_inf = -e.ray.d.normalize();
-            let it = Interaction::at_point(self.prev.p());
+            let it = Interaction::at_point(self.prev.p);
             let (direct, emission, _) = light_densities(scene, id, &it, w_inf);
             // Seen straight from the lens: only the camera finds it.
             let w = if self.vertices == 0 {

@@ -90,6 +90,29 @@ impl HasPosition for LightVertex {
     }
 }
 
+/// What the MIS bookkeeping of a walk reads of the vertex before the
+/// current one (a [`Vertex`] is ten times larger, and copied per vertex).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PrevVertex {
+    /// Position.
+    pub p: Vec3,
+    /// Geometric normal (zero off surfaces).
+    pub n: Vec3,
+    /// A light endpoint at infinity.
+    pub at_infinity: bool,
+}
+
+impl PrevVertex {
+    /// The part of `v` the next vertex's update reads.
+    pub fn of(v: &Vertex) -> Self {
+        Self {
+            p: v.p(),
+            n: v.it.n,
+            at_infinity: v.at_infinity(),
+        }
+    }
+}
+
 /// Light paths per chunk: the unit of parallel work of the light pass and
 /// of storage.
 pub(super) const CHUNK: usize = 4096;
@@ -105,7 +128,7 @@ pub(super) struct PathChunk {
 
 /// The light subpaths of one iteration, kept in the chunks that made them
 /// (no copy into one array; their memory is reused by the next iteration
-/// through [`ChunkPool`]).
+/// through a [`Pool`]).
 pub struct LightPaths {
     chunks: Vec<PathChunk>,
     /// The light-tracing splats (already scaled to one path per pixel).
@@ -142,34 +165,56 @@ impl LightPaths {
     }
 
     /// Hands the chunks' memory back to `pool`.
-    pub(super) fn recycle(self, pool: &ChunkPool) {
+    pub(super) fn recycle(self, pool: &Pool<PathChunk>) {
         pool.give(self.chunks);
     }
 }
 
-/// Chunk buffers kept from one iteration to the next, so a pass does not
-/// allocate (and fault in) its vertex storage anew; the image never
-/// depends on it.
-#[derive(Default)]
-pub(super) struct ChunkPool(Mutex<Vec<PathChunk>>);
+/// Buffers kept from one iteration to the next (vertex chunks, splat
+/// buffers), so a pass does not allocate (and fault in) its storage anew;
+/// the image never depends on it.
+pub(super) struct Pool<T>(Mutex<Vec<T>>);
 
-impl ChunkPool {
+impl<T> Default for Pool<T> {
+    fn default() -> Self {
+        Self(Mutex::new(Vec::new()))
+    }
+}
+
+impl<T> Pool<T> {
+    /// A buffer handed back earlier, if any.
+    fn take(&self) -> Option<T> {
+        self.0.lock().ok().and_then(|mut p| p.pop())
+    }
+
+    /// Keeps `items` for later passes.
+    pub(super) fn give(&self, items: impl IntoIterator<Item = T>) {
+        if let Ok(mut p) = self.0.lock() {
+            p.extend(items);
+        }
+    }
+}
+
+impl Pool<PathChunk> {
     /// An empty chunk, with the memory of an earlier one when there is one.
-    fn take(&self) -> PathChunk {
-        let mut c = self
-            .0
-            .lock()
-            .map(|mut p| p.pop())
-            .unwrap_or_default()
-            .unwrap_or_default();
+    fn chunk(&self) -> PathChunk {
+        let mut c = self.take().unwrap_or_default();
         c.vertices.clear();
         c.ends.clear();
         c
     }
+}
 
-    fn give(&self, chunks: Vec<PathChunk>) {
-        if let Ok(mut p) = self.0.lock() {
-            p.extend(chunks);
+impl Pool<SplatBuffer> {
+    /// A zero splat buffer over the film's pixels, reusing an earlier one.
+    fn splats(&self, ctx: &RenderContext<'_>) -> SplatBuffer {
+        let (lo, hi) = ctx.film.pixel_bounds();
+        match self.take() {
+            Some(mut b) if b.covers(lo, hi) => {
+                b.clear();
+                b
+            }
+            _ => ctx.film.splat_buffer(),
         }
     }
 }
@@ -220,13 +265,13 @@ impl VcmIntegrator {
         let lanes: Vec<(SplatBuffer, Vec<(u64, PathChunk)>)> = (0..LANES as u64)
             .into_par_iter()
             .map(|lane| {
-                let mut buf = ctx.film.splat_buffer();
+                let mut buf = self.pools.splats.splats(ctx);
                 let mut chunks = Vec::new();
                 for c in (lane..n_chunks).step_by(LANES) {
                     if ctx.cancelled() {
                         break;
                     }
-                    let mut out = self.pool.take();
+                    let mut out = self.pools.chunks.chunk();
                     let end = ((c + 1) * chunk).min(n);
                     for i in c * chunk..end {
                         self.trace_light(
@@ -308,7 +353,7 @@ impl VcmIntegrator {
             f,
             lambda,
             mis,
-            prev: ls.vertex,
+            prev: PrevVertex::of(&ls.vertex),
             pending: None,
             out,
             buf,
@@ -354,7 +399,7 @@ struct LightVisitor<'a, 'b> {
     f: &'a Factors,
     lambda: &'a SampledWavelengths,
     mis: Partial,
-    prev: Vertex,
+    prev: PrevVertex,
     pending: Option<Scatter>,
     out: &'a mut Vec<LightVertex>,
     buf: &'a mut SplatBuffer,
@@ -365,17 +410,17 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
 
     fn vertex(&mut self, v: &Vertex, lam: &mut SampledWavelengths, rng: &mut StreamRng) -> Flow {
         if let Some(s) = self.pending.take() {
-            let cos_out = v.wo.dot(self.prev.it.n).abs();
+            let cos_out = v.wo.dot(self.prev.n).abs();
             self.mis
                 .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, self.f);
         }
-        let d2 = if self.prev.at_infinity() {
+        let d2 = if self.prev.at_infinity {
             1.0
         } else {
-            (v.p() - self.prev.p()).length_squared()
+            (v.p() - self.prev.p).length_squared()
         };
         self.mis.hit(d2, v.wo.dot(v.it.n).abs());
-        self.prev = *v;
+        self.prev = PrevVertex::of(v);
         let Some(bsdf) = &v.bsdf else {
             return Flow::Continue;
         };

@@ -243,8 +243,15 @@ pub struct VcmIntegrator {
     /// Light vertices the last finished light pass stored (for the status
     /// line only; the image never depends on it).
     stored: AtomicU64,
-    /// Vertex storage reused from one iteration to the next.
-    pool: light::ChunkPool,
+    /// Storage reused from one iteration to the next.
+    pools: Pools,
+}
+
+/// The buffers a pass hands to the next ([`light::Pool`]).
+#[derive(Default)]
+struct Pools {
+    chunks: light::Pool<light::PathChunk>,
+    splats: light::Pool<crate::film::SplatBuffer>,
 }
 
 impl VcmIntegrator {
@@ -255,7 +262,7 @@ impl VcmIntegrator {
             settings,
             techniques,
             stored: AtomicU64::new(0),
-            pool: light::ChunkPool::default(),
+            pools: Pools::default(),
         }
     }
 
@@ -334,15 +341,16 @@ impl Integrator for VcmIntegrator {
         // shares its wavelengths, so merged power stays spectral.
         let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);
         let time = self.time(ctx, pass);
-        let Some(light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
+        let Some(mut light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
             return PassOutcome::Cancelled;
         };
         self.stored.store(light.len() as u64, Ordering::Relaxed);
         for b in &light.splats {
             block.add_splats(b);
         }
+        self.pools.splats.give(std::mem::take(&mut light.splats));
         if t.light_only {
-            light.recycle(&self.pool);
+            light.recycle(&self.pools.chunks);
             return PassOutcome::Done;
         }
         let grid = (t.merge && !light.is_empty() && radius > 0.0)
@@ -361,7 +369,7 @@ impl Integrator for VcmIntegrator {
             ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
             tile
         });
-        light.recycle(&self.pool);
+        light.recycle(&self.pools.chunks);
         let Some(tiles) = tiles else {
             return PassOutcome::Cancelled;
         };
