@@ -4,9 +4,10 @@
 //! A merge reads, for every light vertex within r of a camera vertex, only
 //! its position, geometric normal, `wo`, β, depth, dispersion flag and the
 //! vertex's partial MIS quantities ([`Partial::merge_weight`]): 72 bytes,
-//! against the 272 of a whole [`LightVertex`] with its BSDF. The photons are
-//! copied once per iteration in the grid's entry order
-//! ([`HashGrid::entry_order`]), so the photons of one bucket are adjacent in
+//! against the 232 of a whole [`LightVertex`] with its BSDF. The photons are
+//! made from the light pass's chunks and copied once per iteration into the
+//! grid's entry order ([`HashGrid::entry_order`]), both in parallel (only
+//! the grid's counting sort runs on one thread), so the photons of one bucket are adjacent in
 //! memory, and a query reads them front to back, positions included
 //! ([`HashGrid::for_each_candidate_run`]): one cache miss per bucket.
 //! Reading the stored vertices through the grid's indices instead was a
