@@ -73,11 +73,31 @@ fn every_mode_agrees_with_the_path_tracer_on_the_cornell_box() {
     }
 }
 
+/// With `connections all`, mode `bpt` is BDPT's estimator (every
+/// connection, one shadow ray each).
 #[test]
 fn mode_bpt_agrees_with_bdpt_on_the_cornell_box() {
     let bd = block_means(&cornell_small("\"bdpt\""), 16);
-    let bpt = block_means(&cornell_small(&vcm("bpt", 0.02)), 16);
+    let bpt = block_means(&cornell_small(&connections("bpt", "all")), 16);
     stats::assert_blocks_agree(&bd, &bpt, "Cornell BDPT vs vcm mode bpt");
+}
+
+fn connections(mode: &str, which: &str) -> String {
+    format!("{} \"string connections\" \"{which}\"", vcm(mode, 0.02))
+}
+
+/// `connections one` joins each camera vertex to one light vertex, drawn
+/// in proportion to its unoccluded MIS-weighted contribution X_j, and adds
+/// V_J X_J / P(J): an unbiased estimate of `all`'s Σ_j V_j X_j. Mode `bpt`
+/// (no merges) leaves the connections their largest share of the image.
+/// The test sees a wrong weight (measured once each): dividing by 1 instead
+/// of P(J) fails it (block 0: p = 6·10⁻⁷), and so does multiplying by the
+/// candidate count n, the weight of a uniform choice (p = 2·10⁻⁶).
+#[test]
+fn one_resampled_connection_agrees_with_all_of_them() {
+    let all = block_means(&cornell_small(&connections("bpt", "all")), 32);
+    let one = block_means(&cornell_small(&connections("bpt", "one")), 32);
+    stats::assert_blocks_agree(&all, &one, "Cornell vcm bpt: connections all vs one");
 }
 
 /// validation.md T4(b) centred: a point light of I = π at the centre of a

@@ -156,6 +156,16 @@ impl BsdfSample {
     }
 }
 
+/// A pair of world directions taken into a BSDF's local frame once
+/// ([`Bsdf::local_pair`]), so f and both densities of the pair are
+/// evaluated without repeating the frame change: what a bidirectional join
+/// needs at each end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalPair {
+    wo: Vec3,
+    wi: Vec3,
+}
+
 /// The closed set of local-frame scattering models.
 #[derive(Clone, Copy, Debug)]
 pub enum Bxdf {
@@ -369,6 +379,39 @@ impl Bsdf {
             return PdfSolidAngle(0.0);
         }
         self.bxdf.pdf(wo, wi, mode, allowed)
+    }
+    /// `wo` and `wi` (world space) in the local frame.
+    #[inline]
+    pub fn local_pair(&self, wo_render: Vec3, wi_render: Vec3) -> LocalPair {
+        LocalPair {
+            wo: self.to_local(wo_render),
+            wi: self.to_local(wi_render),
+        }
+    }
+    /// [`Self::f`] of the pair.
+    #[inline]
+    pub fn f_pair(&self, d: &LocalPair, mode: TransportMode) -> SampledSpectrum {
+        if d.wo.z == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        self.bxdf.f(d.wo, d.wi, mode)
+    }
+    /// The densities [`Self::pdf`] gives the pair, all lobes: forward,
+    /// `pdf(wo, wi, mode)`, and reverse, `pdf(wi, wo, mode.adjoint())`.
+    #[inline]
+    pub fn pdfs_pair(&self, d: &LocalPair, mode: TransportMode) -> (PdfSolidAngle, PdfSolidAngle) {
+        let all = SampleFlags::ALL;
+        let fwd = if d.wo.z == 0.0 {
+            PdfSolidAngle(0.0)
+        } else {
+            self.bxdf.pdf(d.wo, d.wi, mode, all)
+        };
+        let rev = if d.wi.z == 0.0 {
+            PdfSolidAngle(0.0)
+        } else {
+            self.bxdf.pdf(d.wi, d.wo, mode.adjoint(), all)
+        };
+        (fwd, rev)
     }
     /// Applies path regularisation.
     pub fn regularize(&mut self) {

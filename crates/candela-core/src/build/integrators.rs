@@ -14,9 +14,10 @@ use super::{BuildError, Overrides};
 use crate::integrator::photonmap::Kernel;
 use crate::integrator::wavelengths::{DEFAULT_GROUPS, MAX_GROUPS};
 use crate::integrator::{
-    BdptIntegrator, BdptSettings, Integrator, IntegratorKind, LightTracer, LightTracerSettings,
-    PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings, PpmIntegrator,
-    PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator, VcmMode, VcmSettings, Visualize,
+    BdptIntegrator, BdptSettings, Connections, Integrator, IntegratorKind, LightTracer,
+    LightTracerSettings, PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings,
+    PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator, VcmMode, VcmSettings,
+    Visualize,
 };
 use crate::light::LightSelection;
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription};
@@ -436,6 +437,15 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
             format!("\"{name}\" is unknown (known: {})", VcmMode::NAMES),
         ));
     };
+    let name = ck
+        .params
+        .get_string("connections", VcmSettings::default().connections.name())?;
+    let Some(connections) = Connections::from_name(&name) else {
+        return Err(ck.error(
+            "connections",
+            format!("\"{name}\" is unknown (known: {})", Connections::NAMES),
+        ));
+    };
     Ok(VcmSettings {
         max_depth: c.max_depth,
         radius: 1.0,
@@ -444,5 +454,6 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
         seed: photon_seed(ck, c)?,
         regularize: c.regularize,
         mode,
+        connections,
     })
 }

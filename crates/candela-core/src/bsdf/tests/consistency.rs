@@ -136,3 +136,48 @@ fn sampled_values_follow_mode_scaling() {
         }
     }
 }
+
+#[test]
+fn local_pair_evaluation_equals_f_and_both_pdfs_bit_for_bit() {
+    // `Bsdf::local_pair` with `f_pair` and `pdfs_pair` is an evaluation-order
+    // shortcut for bidirectional joins: it must return exactly what `f`,
+    // `pdf` and the adjoint `pdf` return, in a tilted frame, in both modes,
+    // including directions at (or within rounding of) the shading plane.
+    let frame_n = Vec3::new(0.3, 0.8, -0.52).normalize();
+    let tangent = Vec3::new(1.0, -0.2, 0.27);
+    let mut checked = 0;
+    for case in cases() {
+        let bsdf = crate::bsdf::Bsdf::new(frame_n, tangent, case.bxdf);
+        let mut r = Pcg32::new(31, 7);
+        for i in 0..2_000 {
+            let wo = sample_uniform_sphere(u2(&mut r));
+            let wi = if i % 50 == 0 {
+                bsdf.from_local(Vec3::new(wo.x, wo.y, 0.0).normalize_or_zero())
+            } else {
+                sample_uniform_sphere(u2(&mut r))
+            };
+            for mode in MODES {
+                let pair = bsdf.local_pair(wo, wi);
+                let f_pair = bsdf.f_pair(&pair, mode);
+                let (fwd_pair, rev_pair) = bsdf.pdfs_pair(&pair, mode);
+                let f = bsdf.f(wo, wi, mode);
+                let fwd = bsdf.pdf(wo, wi, mode, SampleFlags::ALL);
+                let rev = bsdf.pdf(wi, wo, mode.adjoint(), SampleFlags::ALL);
+                assert!(
+                    f_pair
+                        .0
+                        .iter()
+                        .zip(&f.0)
+                        .all(|(a, b)| a.to_bits() == b.to_bits())
+                        && fwd_pair.0.to_bits() == fwd.0.to_bits()
+                        && rev_pair.0.to_bits() == rev.0.to_bits(),
+                    "{} {mode:?} wo={wo} wi={wi}: {f_pair:?} {fwd_pair:?} {rev_pair:?} vs \
+                     {f:?} {fwd:?} {rev:?}",
+                    case.name
+                );
+                checked += usize::from(!f.is_black() && fwd.0 > 0.0 && rev.0 > 0.0);
+            }
+        }
+    }
+    assert!(checked > 1000, "only {checked} non-zero evaluations");
+}

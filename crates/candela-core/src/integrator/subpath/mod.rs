@@ -41,7 +41,7 @@ mod start;
 mod vertex;
 
 pub use start::{start_light_subpath, LightStart};
-pub use vertex::{dir, to_area, Vertex, VertexKind};
+pub use vertex::{adjoint_cos, dir, to_area, Vertex, VertexKind};
 
 use super::roulette::Roulette;
 use crate::bsdf::{SampleFlags, TransportMode};

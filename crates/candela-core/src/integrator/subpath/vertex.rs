@@ -161,13 +161,19 @@ impl Vertex {
         let Some(bsdf) = &self.bsdf else {
             return SampledSpectrum::zero();
         };
-        let den = self.wo.dot(self.it.n).abs();
-        if den == 0.0 {
-            return SampledSpectrum::zero();
+        match adjoint_cos(&self.it, self.ns, self.wo, wi) {
+            Some(k) => bsdf.f(self.wo, wi, TransportMode::Importance) * k,
+            None => SampledSpectrum::zero(),
         }
-        bsdf.f(self.wo, wi, TransportMode::Importance)
-            * (self.wo.dot(self.ns).abs() * wi.dot(self.it.n).abs() / den)
     }
+}
+
+/// |ωo·ns||ωi·ng|/|ωo·ng|, the factor that makes the importance-mode f into
+/// [`Vertex::f_adjoint_cos`]; `None` when |ωo·ng| = 0.
+#[inline]
+pub fn adjoint_cos(it: &Interaction, ns: Vec3, wo: Vec3, wi: Vec3) -> Option<f32> {
+    let den = wo.dot(it.n).abs();
+    (den != 0.0).then(|| wo.dot(ns).abs() * wi.dot(it.n).abs() / den)
 }
 
 /// Unit direction from `from` towards `to` (handles vertices at infinity).

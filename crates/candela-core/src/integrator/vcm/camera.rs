@@ -19,10 +19,11 @@
 //! with the film's filter weight to a [`FilmTile`], so the camera side
 //! filters exactly as the path tracer does.
 
-use super::light::{light_densities, LightPaths, LightVertex};
+use super::light::{light_densities, LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
 use super::mis::{weight, Factors, Partial};
-use super::VcmIntegrator;
+use super::resample::Resampler;
+use super::{Connections, VcmIntegrator};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::film::FilmTile;
 use crate::integrator::driver::camera_sample;
@@ -36,6 +37,7 @@ use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
+use crate::sampling::PathRng;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// What the camera pass of one iteration shares.
@@ -103,7 +105,8 @@ impl VcmIntegrator {
             },
             SampledSpectrum::splat(ray_weight),
         );
-        let pdf_pixel = self.pixel_density(ctx, &ray);
+        let pdf_dir = ctx.camera.pdf_we(&ray).1;
+        let pdf_pixel = self.pixel_density(pdf_dir, ctx);
         let n_light = self.light_paths(ctx) as f32;
         let mut v = CameraVisitor {
             vcm: self,
@@ -111,7 +114,7 @@ impl VcmIntegrator {
             cp,
             path,
             mis: Partial::camera(pdf_pixel, n_light, ctx.camera.is_connectable()),
-            prev: lens,
+            prev: PrevVertex::of(&lens),
             pending: None,
             specular: true,
             vertices: 0,
@@ -129,7 +132,7 @@ impl VcmIntegrator {
             beta: SampledSpectrum::splat(ray_weight),
             depth: 0,
             from: Some(lens),
-            pdf_dir: ctx.camera.pdf_we(&ray).1,
+            pdf_dir,
         };
         let mut lambda = cp.lambda;
         walk(ctx.scene, &mut lambda, sampler, &w, start, &mut v);
@@ -144,7 +147,7 @@ struct CameraVisitor<'a, 'b> {
     cp: &'a CameraPass<'a>,
     path: &'a [LightVertex],
     mis: Partial,
-    prev: Vertex,
+    prev: PrevVertex,
     pending: Option<Scatter>,
     /// Every scattering so far was a delta.
     specular: bool,
@@ -169,13 +172,13 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
 
     fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut Sampler) -> Flow {
         if let Some(s) = self.pending.take() {
-            let cos_out = v.wo.dot(self.prev.it.n).abs();
+            let cos_out = v.wo.dot(self.prev.n).abs();
             self.mis
                 .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
         }
-        let d2 = (v.p() - self.prev.p()).length_squared();
+        let d2 = (v.p() - self.prev.p).length_squared();
         self.mis.hit(d2, v.wo.dot(v.it.n).abs());
-        self.prev = *v;
+        self.prev = PrevVertex::of(v);
         self.vertices += 1;
         self.emission(v, lambda);
         let max_depth = self.vcm.settings.max_depth;
@@ -189,7 +192,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
         let terminated = lambda.secondary_terminated();
         if t.connect {
             self.next_event(v, bsdf, lambda, rng);
-            self.connect(v, bsdf, terminated);
+            self.connect(v, bsdf, terminated, rng);
         }
         if t.merge {
             self.merge(v, bsdf, terminated);
@@ -207,7 +210,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
         if let Some(s) = self.pending.take() {
-            let cos_out = e.ray.d.normalize().dot(self.prev.it.n).abs();
+            let cos_out = e.ray.d.normalize().dot(self.prev.n).abs();
             self.mis
                 .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
         }
@@ -218,7 +221,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
                 continue;
             }
             let w_inf = -e.ray.d.normalize();
-            let it = Interaction::at_point(self.prev.p());
+            let it = Interaction::at_point(self.prev.p);
             let (direct, emission, _) = light_densities(scene, id, &it, w_inf);
             // Seen straight from the lens: only the camera finds it.
             let w = if self.vertices == 0 {
@@ -299,41 +302,72 @@ impl CameraVisitor<'_, '_> {
         self.l += v.beta * ls.unweighted() * weight(w_light, w_cam);
     }
 
-    /// Connections to the vertices of the pixel's light subpath [eqs. 40–41].
-    fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
+    /// Connections to the vertices of the pixel's light subpath [eqs.
+    /// 40–41]: to every one, or to one resampled in proportion to its
+    /// unoccluded contribution ([`Connections`], module doc of [`super`]).
+    fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool, rng: &mut Sampler) {
         let max_depth = self.vcm.settings.max_depth;
-        for lv in self.path {
-            if lv.v.depth + v.depth > max_depth {
-                break;
+        let path = self.path;
+        let joinable = path.iter().take_while(|lv| lv.depth + v.depth <= max_depth);
+        let scene = self.ctx.scene;
+        match self.vcm.settings.connections {
+            Connections::All => {
+                for lv in joinable {
+                    let Some(x) = self.connection(v, cb, lv, terminated) else {
+                        continue;
+                    };
+                    if scene.unoccluded(&lv.it, &v.it) {
+                        self.l += x;
+                    }
+                }
             }
-            let Some(lb) = &lv.v.bsdf else { continue };
-            let d = lv.v.p() - v.p();
-            let d2 = d.length_squared();
-            if d2 == 0.0 {
-                continue;
+            Connections::One => {
+                let mut r = Resampler::new(rng.u1());
+                for lv in joinable {
+                    if let Some(x) = self.connection(v, cb, lv, terminated) {
+                        r.offer((lv, x), x.average());
+                    }
+                }
+                if let Some(((lv, x), inv_p)) = r.pick() {
+                    if scene.unoccluded(&lv.it, &v.it) {
+                        self.l += x * inv_p;
+                    }
+                }
             }
-            let w = d / d2.sqrt();
-            let f_cam = cb.f(v.wo, w, TransportMode::Radiance) * w.dot(v.ns).abs();
-            let c = v.beta * f_cam * lv.v.f_adjoint_cos(-w) * lv.v.beta / d2;
-            if c.is_black() {
-                continue;
-            }
-            let all = SampleFlags::ALL;
-            let cam_dir = cb.pdf(v.wo, w, TransportMode::Radiance, all).0;
-            let cam_rev = cb.pdf(w, v.wo, TransportMode::Importance, all).0;
-            let light_dir = lb.pdf(lv.v.wo, -w, TransportMode::Importance, all).0;
-            let light_rev = lb.pdf(-w, lv.v.wo, TransportMode::Radiance, all).0;
-            let cam_dir_a = cam_dir * w.dot(lv.v.it.n).abs() / d2;
-            let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
-            let f = &self.cp.f;
-            let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
-            let w_cam = self.mis.connect_weight(light_dir_a, cam_rev, f);
-            let mw = weight(w_light, w_cam);
-            if mw == 0.0 || !self.ctx.scene.unoccluded(&lv.v.it, &v.it) {
-                continue;
-            }
-            self.l += unfold(c * mw, terminated, lv.terminated);
         }
+    }
+
+    /// The MIS-weighted contribution of joining `v` to light vertex `lv`
+    /// if nothing lies between them [eqs. 40–41]; `None` when it is zero.
+    fn connection(
+        &self,
+        v: &Vertex,
+        cb: &Bsdf,
+        lv: &LightVertex,
+        terminated: bool,
+    ) -> Option<SampledSpectrum> {
+        let d = lv.p() - v.p();
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let w = d / d2.sqrt();
+        let cam = cb.local_pair(v.wo, w);
+        let f_cam = cb.f_pair(&cam, TransportMode::Radiance) * w.dot(v.ns).abs();
+        let (f_light, light) = lv.f_adjoint_cos(-w);
+        let c = v.beta * f_cam * f_light * lv.beta / d2;
+        if c.is_black() {
+            return None;
+        }
+        let (cam_dir, cam_rev) = cb.pdfs_pair(&cam, TransportMode::Radiance);
+        let (light_dir, light_rev) = lv.pdfs(&light);
+        let cam_dir_a = cam_dir.0 * w.dot(lv.it.n).abs() / d2;
+        let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
+        let f = &self.cp.f;
+        let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
+        let w_cam = self.mis.connect_weight(light_dir_a, cam_rev.0, f);
+        let mw = weight(w_light, w_cam);
+        (mw != 0.0).then(|| unfold(c * mw, terminated, lv.terminated))
     }
 
     /// Merges with the iteration's light vertices around `v` [eqs. 38–39].
@@ -355,23 +389,18 @@ impl CameraVisitor<'_, '_> {
             let Some(c) = gather(&x, &ph.surfel, r2) else {
                 return;
             };
-            let wi = c.wi;
-            let fv = cb.f(v.wo, wi, TransportMode::Radiance);
+            let pair = cb.local_pair(v.wo, c.wi);
+            let fv = cb.f_pair(&pair, TransportMode::Radiance);
             if fv.is_black() {
                 return;
             }
             let w = if ppm {
                 1.0
             } else {
-                let cam_dir = cb
-                    .pdf(v.wo, wi, TransportMode::Radiance, SampleFlags::ALL)
-                    .0;
-                let cam_rev = cb
-                    .pdf(wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
-                    .0;
+                let (cam_dir, cam_rev) = cb.pdfs_pair(&pair, TransportMode::Radiance);
                 weight(
-                    ph.mis.merge_weight(cam_dir, f),
-                    self.mis.merge_weight(cam_rev, f),
+                    ph.mis.merge_weight(cam_dir.0, f),
+                    self.mis.merge_weight(cam_rev.0, f),
                 )
             };
             sum += unfold(fv * ph.beta * w, terminated, ph.terminated);

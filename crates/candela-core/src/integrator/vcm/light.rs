@@ -10,16 +10,20 @@
 //! 34–36 is applied there, then the arrival (distance², cosine) of the new
 //! vertex. Chunks of paths run on [`LANES`] fixed lanes and are put back in
 //! path order, so the stored vertices and splats do not depend on the
-//! thread count.
+//! thread count. The vertices stay in the chunk that made them
+//! ([`LightPaths::path`] finds a path's), and chunk and splat buffers are
+//! reused by the next iteration (`Pool`): copying the chunks into one
+//! array, into freshly faulted pages, was a serial memcpy of ~12 MB per
+//! iteration at 128².
 
 use super::mis::{weight, Factors, Partial};
 use super::{Techniques, VcmIntegrator};
-use crate::bsdf::TransportMode;
+use crate::bsdf::{Bsdf, LocalPair, TransportMode};
 use crate::film::SplatBuffer;
 use crate::integrator::driver::LANES;
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
-    start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
+    adjoint_cos, start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
 };
 use crate::integrator::RenderContext;
 use crate::interaction::{Interaction, LightId};
@@ -30,30 +34,107 @@ use crate::scene::Scene;
 use crate::spatial::HasPosition;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
+use std::sync::Mutex;
 
-/// A stored light-subpath vertex.
+/// A stored light-subpath vertex: what a connection reads of it (a
+/// [`Vertex`] also carries the walk's bookkeeping, which no join needs).
 #[derive(Clone, Copy, Debug)]
 pub struct LightVertex {
-    /// The vertex (position, normals, `wo`, BSDF, β, depth).
-    pub v: Vertex,
+    /// Position, error bound, geometric normal, time (for the shadow ray).
+    pub it: Interaction,
+    /// Shading normal.
+    pub ns: Vec3,
+    /// Unit direction towards the previous vertex (towards the light).
+    pub wo: Vec3,
+    /// The scattering function there.
+    pub bsdf: Bsdf,
+    /// The light subpath's throughput (power) at the vertex.
+    pub beta: SampledSpectrum,
     /// Its partial MIS quantities.
     pub mis: Partial,
+    /// Surface vertices of the light subpath up to this one.
+    pub depth: u32,
     /// Its subpath kept only the hero wavelength (dispersion, folded into β).
     pub terminated: bool,
 }
 
-impl HasPosition for LightVertex {
-    fn position(&self) -> Vec3 {
-        self.v.p()
+impl LightVertex {
+    /// Position.
+    #[inline]
+    pub fn p(&self) -> Vec3 {
+        self.it.p
+    }
+
+    /// f̂ towards `wi` with the adjoint shading-normal correction
+    /// ([`Vertex::f_adjoint_cos`]) and the frame-local pair of directions
+    /// it was evaluated for (for [`LightVertex::pdfs`]).
+    #[inline]
+    pub fn f_adjoint_cos(&self, wi: Vec3) -> (SampledSpectrum, LocalPair) {
+        let pair = self.bsdf.local_pair(self.wo, wi);
+        let f = match adjoint_cos(&self.it, self.ns, self.wo, wi) {
+            Some(k) => self.bsdf.f_pair(&pair, TransportMode::Importance) * k,
+            None => SampledSpectrum::zero(),
+        };
+        (f, pair)
+    }
+
+    /// The densities of scattering along `pair` (importance, towards `wi`)
+    /// and back (radiance, towards `wo`): one end of a connection's weight
+    /// [eqs. 40–41].
+    #[inline]
+    pub fn pdfs(&self, pair: &LocalPair) -> (f32, f32) {
+        let (fwd, rev) = self.bsdf.pdfs_pair(pair, TransportMode::Importance);
+        (fwd.0, rev.0)
     }
 }
 
-/// The light subpaths of one iteration.
-pub struct LightPaths {
+impl HasPosition for LightVertex {
+    fn position(&self) -> Vec3 {
+        self.it.p
+    }
+}
+
+/// What the MIS bookkeeping of a walk reads of the vertex before the
+/// current one (a [`Vertex`] is ten times larger, and copied per vertex).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PrevVertex {
+    /// Position.
+    pub p: Vec3,
+    /// Geometric normal (zero off surfaces).
+    pub n: Vec3,
+    /// A light endpoint at infinity.
+    pub at_infinity: bool,
+}
+
+impl PrevVertex {
+    /// The part of `v` the next vertex's update reads.
+    pub fn of(v: &Vertex) -> Self {
+        Self {
+            p: v.p(),
+            n: v.it.n,
+            at_infinity: v.at_infinity(),
+        }
+    }
+}
+
+/// Light paths per chunk: the unit of parallel work of the light pass and
+/// of storage.
+pub(super) const CHUNK: usize = 4096;
+
+/// The stored vertices of [`CHUNK`] consecutive light paths.
+#[derive(Default)]
+pub(super) struct PathChunk {
     /// Every stored vertex, path after path, each path's in depth order.
-    pub vertices: Vec<LightVertex>,
-    /// Path i owns `vertices[start[i]..start[i + 1]]`.
-    pub start: Vec<u32>,
+    vertices: Vec<LightVertex>,
+    /// Path j of the chunk owns `vertices[ends[j - 1]..ends[j]]` (from 0 for j = 0).
+    ends: Vec<u32>,
+}
+
+/// The light subpaths of one iteration, kept in the chunks that made them
+/// (no copy into one array; their memory is reused by the next iteration
+/// through a `Pool`).
+pub struct LightPaths {
+    chunks: Vec<PathChunk>,
     /// The light-tracing splats (already scaled to one path per pixel).
     pub splats: Vec<SplatBuffer>,
 }
@@ -61,9 +142,83 @@ pub struct LightPaths {
 impl LightPaths {
     /// The vertices of path `i`.
     pub fn path(&self, i: usize) -> &[LightVertex] {
-        match (self.start.get(i), self.start.get(i + 1)) {
-            (Some(&a), Some(&b)) => &self.vertices[a as usize..b as usize],
-            _ => &[],
+        let Some(c) = self.chunks.get(i / CHUNK) else {
+            return &[];
+        };
+        let j = i % CHUNK;
+        let a = if j == 0 { 0 } else { c.ends[j - 1] as usize };
+        match c.ends.get(j) {
+            Some(&b) => &c.vertices[a..b as usize],
+            None => &[],
+        }
+    }
+
+    /// Every stored vertex, path after path, chunk by chunk.
+    pub fn chunks(&self) -> Vec<&[LightVertex]> {
+        self.chunks.iter().map(|c| c.vertices.as_slice()).collect()
+    }
+
+    /// Number of stored vertices.
+    pub fn len(&self) -> usize {
+        self.chunks.iter().map(|c| c.vertices.len()).sum()
+    }
+
+    /// True when no vertex is stored.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Hands the chunks' memory back to `pool`.
+    pub(super) fn recycle(self, pool: &Pool<PathChunk>) {
+        pool.give(self.chunks);
+    }
+}
+
+/// Buffers kept from one iteration to the next (vertex chunks, splat
+/// buffers), so a pass does not allocate (and fault in) its storage anew;
+/// the image never depends on it.
+pub(super) struct Pool<T>(Mutex<Vec<T>>);
+
+impl<T> Default for Pool<T> {
+    fn default() -> Self {
+        Self(Mutex::new(Vec::new()))
+    }
+}
+
+impl<T> Pool<T> {
+    /// A buffer handed back earlier, if any.
+    fn take(&self) -> Option<T> {
+        self.0.lock().ok().and_then(|mut p| p.pop())
+    }
+
+    /// Keeps `items` for later passes.
+    pub(super) fn give(&self, items: impl IntoIterator<Item = T>) {
+        if let Ok(mut p) = self.0.lock() {
+            p.extend(items);
+        }
+    }
+}
+
+impl Pool<PathChunk> {
+    /// An empty chunk, with the memory of an earlier one when there is one.
+    fn chunk(&self) -> PathChunk {
+        let mut c = self.take().unwrap_or_default();
+        c.vertices.clear();
+        c.ends.clear();
+        c
+    }
+}
+
+impl Pool<SplatBuffer> {
+    /// A zero splat buffer over the film's pixels, reusing an earlier one.
+    fn splats(&self, ctx: &RenderContext<'_>) -> SplatBuffer {
+        let (lo, hi) = ctx.film.pixel_bounds();
+        match self.take() {
+            Some(mut b) if b.covers(lo, hi) => {
+                b.clear();
+                b
+            }
+            _ => ctx.film.splat_buffer(),
         }
     }
 }
@@ -97,12 +252,6 @@ pub fn light_densities(scene: &Scene, id: LightId, it: &Interaction, w: Vec3) ->
     (pmf * direct, pmf * pos * dir, cos)
 }
 
-/// Light paths per parallel chunk.
-const CHUNK: u64 = 4096;
-
-/// What one chunk of paths made.
-type Chunk = (u64, Vec<LightVertex>, Vec<u32>);
-
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
     /// `lambda` and time `time`; `None` if the render was cancelled.
@@ -115,25 +264,34 @@ impl VcmIntegrator {
         f: &Factors,
     ) -> Option<LightPaths> {
         let n = self.light_paths(ctx);
-        let n_chunks = n.div_ceil(CHUNK);
-        let lanes: Vec<(SplatBuffer, Vec<Chunk>)> = (0..LANES as u64)
+        let chunk = CHUNK as u64;
+        let n_chunks = n.div_ceil(chunk);
+        let lanes: Vec<(SplatBuffer, Vec<(u64, PathChunk)>)> = (0..LANES as u64)
             .into_par_iter()
             .map(|lane| {
-                let mut buf = ctx.film.splat_buffer();
+                let mut buf = self.pools.splats.splats(ctx);
                 let mut chunks = Vec::new();
                 for c in (lane..n_chunks).step_by(LANES) {
                     if ctx.cancelled() {
                         break;
                     }
-                    let (mut verts, mut lens) = (Vec::new(), Vec::new());
-                    let end = ((c + 1) * CHUNK).min(n);
-                    for i in c * CHUNK..end {
-                        let before = verts.len();
-                        self.trace_light(ctx, pass, i, lambda, time, f, &mut verts, &mut buf);
-                        lens.push((verts.len() - before) as u32);
+                    let mut out = self.pools.chunks.chunk();
+                    let end = ((c + 1) * chunk).min(n);
+                    for i in c * chunk..end {
+                        self.trace_light(
+                            ctx,
+                            pass,
+                            i,
+                            lambda,
+                            time,
+                            f,
+                            &mut out.vertices,
+                            &mut buf,
+                        );
+                        out.ends.push(out.vertices.len() as u32);
                     }
-                    ctx.advance(end - c * CHUNK);
-                    chunks.push((c, verts, lens));
+                    ctx.advance(end - c * chunk);
+                    chunks.push((c, out));
                 }
                 (buf, chunks)
             })
@@ -148,19 +306,10 @@ impl VcmIntegrator {
             chunks.extend(c);
         }
         chunks.sort_by_key(|c| c.0);
-        let mut out = LightPaths {
-            vertices: Vec::new(),
-            start: vec![0],
+        Some(LightPaths {
+            chunks: chunks.into_iter().map(|(_, c)| c).collect(),
             splats,
-        };
-        for (_, verts, lens) in chunks {
-            out.vertices.extend(verts);
-            for l in lens {
-                let last = *out.start.last().unwrap_or(&0);
-                out.start.push(last + l);
-            }
-        }
-        Some(out)
+        })
     }
 
     /// Walks light path `i`, storing its vertices in `out` and splatting its
@@ -208,7 +357,7 @@ impl VcmIntegrator {
             f,
             lambda,
             mis,
-            prev: ls.vertex,
+            prev: PrevVertex::of(&ls.vertex),
             pending: None,
             out,
             buf,
@@ -254,7 +403,7 @@ struct LightVisitor<'a, 'b> {
     f: &'a Factors,
     lambda: &'a SampledWavelengths,
     mis: Partial,
-    prev: Vertex,
+    prev: PrevVertex,
     pending: Option<Scatter>,
     out: &'a mut Vec<LightVertex>,
     buf: &'a mut SplatBuffer,
@@ -265,17 +414,17 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
 
     fn vertex(&mut self, v: &Vertex, lam: &mut SampledWavelengths, rng: &mut StreamRng) -> Flow {
         if let Some(s) = self.pending.take() {
-            let cos_out = v.wo.dot(self.prev.it.n).abs();
+            let cos_out = v.wo.dot(self.prev.n).abs();
             self.mis
                 .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, self.f);
         }
-        let d2 = if self.prev.at_infinity() {
+        let d2 = if self.prev.at_infinity {
             1.0
         } else {
-            (v.p() - self.prev.p()).length_squared()
+            (v.p() - self.prev.p).length_squared()
         };
         self.mis.hit(d2, v.wo.dot(v.it.n).abs());
-        self.prev = *v;
+        self.prev = PrevVertex::of(v);
         let Some(bsdf) = &v.bsdf else {
             return Flow::Continue;
         };
@@ -285,8 +434,13 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
         let t: &Techniques = &self.vcm.techniques;
         if t.connect || t.merge {
             self.out.push(LightVertex {
-                v: *v,
+                it: v.it,
+                ns: v.ns,
+                wo: v.wo,
+                bsdf: *bsdf,
+                beta: v.beta,
                 mis: self.mis,
+                depth: v.depth,
                 terminated: lam.secondary_terminated(),
             });
         }
@@ -324,7 +478,8 @@ impl LightVisitor<'_, '_> {
             1.0
         } else {
             let d2 = (cs.p_lens.p - v.p()).length_squared();
-            let pdf_pixel = self.vcm.pixel_density(ctx, &Ray::new(cs.p_lens.p, -cs.wi));
+            let pdf_dir = ctx.camera.pdf_we(&Ray::new(cs.p_lens.p, -cs.wi)).1;
+            let pdf_pixel = self.vcm.pixel_density(pdf_dir, ctx);
             let n_light = self.vcm.light_paths(ctx) as f32;
             let pdf_cam_a = pdf_pixel * cs.wi.dot(v.it.n).abs() / (d2 * n_light);
             let pdf_rev = v.bsdf.as_ref().map_or(0.0, |b| {

@@ -4,9 +4,10 @@
 //! A merge reads, for every light vertex within r of a camera vertex, only
 //! its position, geometric normal, `wo`, β, depth, dispersion flag and the
 //! vertex's partial MIS quantities ([`Partial::merge_weight`]): 72 bytes,
-//! against the 272 of a whole [`LightVertex`] with its BSDF. The photons are
-//! copied once per iteration in the grid's entry order
-//! ([`HashGrid::entry_order`]), so the photons of one bucket are adjacent in
+//! against the 232 of a whole [`LightVertex`] with its BSDF. The photons are
+//! made from the light pass's chunks and copied once per iteration into the
+//! grid's entry order ([`HashGrid::entry_order`]), both in parallel (only
+//! the grid's counting sort runs on one thread), so the photons of one bucket are adjacent in
 //! memory, and a query reads them front to back, positions included
 //! ([`HashGrid::for_each_candidate_run`]): one cache miss per bucket.
 //! Reading the stored vertices through the grid's indices instead was a
@@ -14,12 +15,13 @@
 //! on the Cornell box at 128² that load alone was 18 % of a VCM iteration
 //! (`perf annotate`, the merge loop was 39 % of it).
 
-use super::light::LightVertex;
+use super::light::{LightPaths, LightVertex};
 use super::mis::Partial;
 use crate::integrator::gather::Surfel;
 use crate::math::Vec3;
-use crate::spatial::HashGrid;
+use crate::spatial::{HasPosition, HashGrid};
 use crate::spectrum::SampledSpectrum;
+use rayon::prelude::*;
 
 /// Bytes a merging iteration adds per stored vertex: its photon, and the
 /// grid's position, index and (about one per vertex) bucket start.
@@ -45,15 +47,21 @@ impl Photon {
     fn new(lv: &LightVertex) -> Self {
         Photon {
             surfel: Surfel {
-                p: lv.v.p(),
-                n: lv.v.it.n,
-                w: lv.v.wo,
+                p: lv.it.p,
+                n: lv.it.n,
+                w: lv.wo,
             },
-            beta: lv.v.beta,
+            beta: lv.beta,
             mis: lv.mis,
-            depth: lv.v.depth,
+            depth: lv.depth,
             terminated: lv.terminated,
         }
+    }
+}
+
+impl HasPosition for Photon {
+    fn position(&self) -> Vec3 {
+        self.surfel.p
     }
 }
 
@@ -65,13 +73,20 @@ pub(super) struct MergeGrid {
 }
 
 impl MergeGrid {
-    /// The grid for merge radius `radius` over `vertices`.
-    pub fn build(vertices: &[LightVertex], radius: f32) -> Self {
-        let grid = HashGrid::build(vertices, radius);
+    /// The grid for merge radius `radius` over the stored vertices of `light`.
+    /// The photons are made and reordered in parallel; only the grid's
+    /// counting sort is serial.
+    pub fn build(light: &LightPaths, radius: f32) -> Self {
+        let photons: Vec<Photon> = light
+            .chunks()
+            .par_iter()
+            .flat_map_iter(|c| c.iter().map(Photon::new))
+            .collect();
+        let grid = HashGrid::build(&photons, radius);
         let photons = grid
             .entry_order()
-            .iter()
-            .map(|&i| Photon::new(&vertices[i as usize]))
+            .par_iter()
+            .map(|&i| photons[i as usize])
             .collect();
         MergeGrid { grid, photons }
     }
