@@ -16,10 +16,10 @@
 //! The densities next to the connection are unknown to either subpath and
 //! are computed here; all others were stored by the random walks.
 
-use super::density::{pdf, pdf_light_origin};
+use super::density::{pdf, pdf_light_origin, pdf_scatter_pair};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
-use crate::integrator::subpath::Vertex;
+use crate::integrator::subpath::{Vertex, VertexKind};
 use crate::light::LightType;
 use crate::scene::Scene;
 
@@ -129,20 +129,31 @@ impl PathDensities {
         }
         let (imp, rad) = (TransportMode::Importance, TransportMode::Radiance);
         let x = |i: usize| view.get(i);
+        // At a surface vertex with both neighbours the two densities of a
+        // connection end come from one pair evaluation (`pdf_scatter_pair`).
+        let surface = |i: usize| x(i).kind == VertexKind::Surface;
         if s == 0 {
             p_light[0] = pdf_light_origin(scene, x(0), x(1));
+        } else if s >= 2 && surface(s - 1) {
+            (p_light[s], p_eye[s - 2]) = pdf_scatter_pair(x(s - 1), x(s - 2), x(s), imp);
         } else {
             let prev = (s >= 2).then(|| x(s - 2));
             p_light[s] = pdf(scene, camera, x(s - 1), prev, x(s), imp);
+            if s >= 2 {
+                p_eye[s - 2] = pdf(scene, camera, x(s - 1), Some(x(s)), x(s - 2), rad);
+            }
+        }
+        if s >= 1 && view.t >= 2 && surface(s) {
+            (p_eye[s - 1], p_light[s + 1]) = pdf_scatter_pair(x(s), x(s + 1), x(s - 1), rad);
+            return;
+        }
+        if s >= 1 {
             let prev = (view.t >= 2).then(|| x(s + 1));
             p_eye[s - 1] = pdf(scene, camera, x(s), prev, x(s - 1), rad);
         }
         if s + 1 < n {
             let prev = (s >= 1).then(|| x(s - 1));
             p_light[s + 1] = pdf(scene, camera, x(s), prev, x(s + 1), imp);
-        }
-        if s >= 2 {
-            p_eye[s - 2] = pdf(scene, camera, x(s - 1), Some(x(s)), x(s - 2), rad);
         }
     }
 }
