@@ -14,7 +14,7 @@
 //! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
 
 use super::density::{emitted, pdf_light_origin};
-use super::mis::{mis_weight, MisHeuristic, PathDensities, PathView};
+use super::mis::{mis_weight, MisHeuristic, PathView};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
 use crate::integrator::nee::{sample_light, Receiver};
@@ -25,7 +25,6 @@ use crate::sampler::Sampler;
 use crate::sampling::PdfArea;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use std::cell::RefCell;
 
 /// One strategy's result.
 #[derive(Clone, Copy, Debug)]
@@ -48,14 +47,11 @@ pub(crate) struct ConnectCtx<'a> {
     pub lambda: &'a SampledWavelengths,
     /// MIS heuristic.
     pub heuristic: MisHeuristic,
-    /// Reused density buffers of the MIS weights.
-    pub scratch: RefCell<PathDensities>,
 }
 
 impl ConnectCtx<'_> {
     fn weight(&self, view: &PathView<'_>) -> f32 {
-        let mut scratch = self.scratch.borrow_mut();
-        mis_weight(self.scene, self.camera, view, self.heuristic, &mut scratch)
+        mis_weight(self.scene, self.camera, view, self.heuristic)
     }
 }
 

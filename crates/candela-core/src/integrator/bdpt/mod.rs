@@ -39,17 +39,15 @@ use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use connect::{connect, ConnectCtx, Contribution};
-use mis::PathDensities;
 use std::cell::RefCell;
 use walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
 
-/// Storage every sample of a thread reuses: both subpaths and the MIS
-/// densities (no allocation per sample once the buffers have grown).
+/// Storage every sample of a thread reuses: both subpaths (no allocation
+/// per sample once the buffers have grown).
 #[derive(Default)]
 struct Scratch {
     cam: Vec<Vertex>,
     light: Vec<Vertex>,
-    densities: PathDensities,
 }
 
 thread_local! {
@@ -163,11 +161,7 @@ impl BdptIntegrator {
         visit: &mut impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
     ) {
         let max_depth = self.settings.max_depth as usize;
-        let Scratch {
-            cam,
-            light,
-            densities,
-        } = scratch;
+        let Scratch { cam, light } = scratch;
         let walk = |max_vertices| WalkSettings {
             max_vertices,
             regularize: self.settings.regularize,
@@ -189,7 +183,6 @@ impl BdptIntegrator {
             camera: ctx.camera,
             lambda: &lambda,
             heuristic: self.settings.heuristic,
-            scratch: RefCell::new(std::mem::take(densities)),
         };
         // s = 1 resamples the light (`connect_light`) and does not use the
         // light subpath, so it runs even when that subpath is empty because
@@ -211,6 +204,5 @@ impl BdptIntegrator {
                 }
             }
         }
-        *densities = cx.scratch.into_inner();
     }
 }
