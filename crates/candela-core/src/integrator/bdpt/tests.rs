@@ -295,10 +295,12 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
                     for view in emitter_views(&rs, &cam, t) {
                         check_view(&rs, &view, h, &mut cov);
                     }
-                } else if let Some((c, view)) = strategy(&cx, &light, &cam, s, t, &mut sampler) {
-                    if !c.0.is_black() {
-                        check_view(&rs, &view, h, &mut cov);
-                    }
+                } else {
+                    strategy(&cx, &light, &cam, s, t, &mut sampler, |c, view| {
+                        if !c.0.is_black() {
+                            check_view(&rs, view, h, &mut cov);
+                        }
+                    });
                 }
             }
         }
