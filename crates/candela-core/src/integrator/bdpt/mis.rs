@@ -196,42 +196,52 @@ impl PathDensities {
     }
 }
 
-/// Whether strategy k (k light vertices, n − k camera vertices) can make
-/// the path of n vertices whose specular flags `delta(i)` gives.
-pub(crate) fn strategy_valid_by(
-    scene: &Scene,
-    camera: &Camera,
-    x0: &Vertex,
+/// Which strategies can make a path of n vertices starting at x0: the
+/// conditions that do not depend on k, evaluated once per path.
+pub(crate) struct Strategies {
     n: usize,
-    delta: impl Fn(usize) -> bool,
-    k: usize,
-) -> bool {
-    if k >= n {
-        return false; // t = 0: candela never hits the lens.
-    }
-    if k == 0 {
-        return x0.is_hittable_light(scene);
-    }
-    if delta(k - 1) || delta(k) {
-        return false;
-    }
-    if k == n - 1 {
-        if !camera.is_connectable() {
-            return false;
-        }
-        if k == 1 {
-            // s = 1, t = 1: only a visible area light can be seen directly.
-            let area = x0.light_id().is_some_and(|id| {
-                let l = scene.light(id);
-                l.light_type() == LightType::Area && l.is_hittable()
-            });
-            return area;
-        }
-    }
-    true
+    /// k = 0 needs a hittable emitter at x0.
+    x0_hittable: bool,
+    /// k = n − 1 (t = 1) needs a camera that can be connected to and, when
+    /// also k = 1, a visible area light at x0.
+    last_ok: bool,
 }
 
-/// [`strategy_valid_by`] with the flags in a slice.
+impl Strategies {
+    /// The strategies of a path of `n` vertices whose light end is `x0`.
+    pub fn new(scene: &Scene, camera: &Camera, x0: &Vertex, n: usize) -> Self {
+        let last_ok = camera.is_connectable()
+            && (n != 2
+                || x0.light_id().is_some_and(|id| {
+                    // s = 1, t = 1: only a visible area light can be seen directly.
+                    let l = scene.light(id);
+                    l.light_type() == LightType::Area && l.is_hittable()
+                }));
+        Self {
+            n,
+            x0_hittable: x0.is_hittable_light(scene),
+            last_ok,
+        }
+    }
+
+    /// Whether strategy k (k light vertices, n − k camera vertices) can make
+    /// the path whose specular flags `delta(i)` gives.
+    #[inline]
+    pub fn valid(&self, delta: impl Fn(usize) -> bool, k: usize) -> bool {
+        if k >= self.n {
+            return false; // t = 0: candela never hits the lens.
+        }
+        if k == 0 {
+            return self.x0_hittable;
+        }
+        if delta(k - 1) || delta(k) {
+            return false;
+        }
+        k != self.n - 1 || self.last_ok
+    }
+}
+
+/// [`Strategies::valid`] with the flags in a slice.
 #[cfg(test)]
 pub(crate) fn strategy_valid(
     scene: &Scene,
@@ -240,7 +250,7 @@ pub(crate) fn strategy_valid(
     delta: &[bool],
     k: usize,
 ) -> bool {
-    strategy_valid_by(scene, camera, x0, delta.len(), |i| delta[i], k)
+    Strategies::new(scene, camera, x0, delta.len()).valid(|i| delta[i], k)
 }
 
 /// MIS weight of strategy `s` for the path with densities `d` (the
@@ -288,7 +298,8 @@ pub(crate) fn mis_weight(
     let (n, s) = (view.n(), view.s);
     let j = JoinDensities::of(scene, camera, view);
     let x0 = view.get(0);
-    let valid = |k: usize| strategy_valid_by(scene, camera, x0, n, |i| is_delta(view, i), k);
+    let strategies = Strategies::new(scene, camera, x0, n);
+    let valid = |k: usize| strategies.valid(|i| is_delta(view, i), k);
     let remap0 = |p: f32| if p != 0.0 { p } else { 1.0 };
     let mut sum = 1.0f32;
     let mut r = 1.0f32;
