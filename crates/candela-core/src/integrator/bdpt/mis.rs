@@ -68,6 +68,7 @@ impl PathView<'_> {
     }
 
     /// Vertex i counted from the light end.
+    #[inline]
     pub fn get(&self, i: usize) -> &Vertex {
         if i < self.s {
             match &self.light_end {
@@ -226,7 +227,7 @@ impl Strategies {
 
     /// Whether strategy k (k light vertices, n − k camera vertices) can make
     /// the path whose specular flags `delta(i)` gives.
-    #[inline]
+    #[inline(always)]
     pub fn valid(&self, delta: impl Fn(usize) -> bool, k: usize) -> bool {
         if k >= self.n {
             return false; // t = 0: candela never hits the lens.
