@@ -14,7 +14,7 @@
 //! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
 
 use super::density::{emitted, pdf_light_origin};
-use super::mis::{mis_weight, MisHeuristic, PathDensities, PathView};
+use super::mis::{mis_weight, MisHeuristic, PathView};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
 use crate::integrator::nee::{sample_light, Receiver};
@@ -25,7 +25,6 @@ use crate::sampler::Sampler;
 use crate::sampling::PdfArea;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use std::cell::RefCell;
 
 /// One strategy's result.
 #[derive(Clone, Copy, Debug)]
@@ -48,14 +47,11 @@ pub(crate) struct ConnectCtx<'a> {
     pub lambda: &'a SampledWavelengths,
     /// MIS heuristic.
     pub heuristic: MisHeuristic,
-    /// Reused density buffers of the MIS weights.
-    pub scratch: RefCell<PathDensities>,
 }
 
 impl ConnectCtx<'_> {
     fn weight(&self, view: &PathView<'_>) -> f32 {
-        let mut scratch = self.scratch.borrow_mut();
-        mis_weight(self.scene, self.camera, view, self.heuristic, &mut scratch)
+        mis_weight(self.scene, self.camera, view, self.heuristic)
     }
 }
 
@@ -71,43 +67,47 @@ pub(crate) fn connect(
     if s == 0 {
         return connect_emitter(cx, cam, t);
     }
-    let (c, view) = strategy(cx, light, cam, s, t, sampler)?;
-    let w = cx.weight(&view);
-    Some(Contribution {
-        unweighted: c.0,
-        weighted: c.0 * w,
-        p_raster: c.1,
+    strategy(cx, light, cam, s, t, sampler, |(c, p_raster), view| {
+        let w = cx.weight(view);
+        Contribution {
+            unweighted: c,
+            weighted: c * w,
+            p_raster,
+        }
     })
 }
 
 /// Unweighted contribution and raster position (t = 1) of a strategy.
 pub(crate) type Unweighted = (SampledSpectrum, Option<Vec2>);
 
-/// The unweighted contribution of strategy (s ≥ 1, t) and the path it made.
-pub(crate) fn strategy<'a>(
+/// Hands the unweighted contribution of strategy (s ≥ 1, t) and the path
+/// it made to `k` (the path is built in place, never moved); `None` when
+/// the strategy contributes nothing.
+pub(crate) fn strategy<R>(
     cx: &ConnectCtx<'_>,
-    light: &'a [Vertex],
-    cam: &'a [Vertex],
+    light: &[Vertex],
+    cam: &[Vertex],
     s: usize,
     t: usize,
     sampler: &mut Sampler,
-) -> Option<(Unweighted, PathView<'a>)> {
+    k: impl FnOnce(Unweighted, &PathView<'_>) -> R,
+) -> Option<R> {
     debug_assert!(s >= 1 && t >= 1);
     if cam[t - 1].at_infinity() {
         return None;
     }
     if t == 1 {
-        connect_camera(cx, light, cam, s, sampler)
+        connect_camera(cx, light, cam, s, sampler, k)
     } else if s == 1 {
-        connect_light(cx, light, cam, t, sampler)
+        connect_light(cx, light, cam, t, sampler, k)
     } else {
-        connect_inner(cx, light, cam, s, t)
+        connect_inner(cx, light, cam, s, t, k)
     }
 }
 
 /// s = 0: emission of the last camera vertex (every infinite light for an escaped ray).
 fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Contribution> {
-    let v = cam[t - 1];
+    let v = &cam[t - 1];
     let mut out = Contribution {
         unweighted: SampledSpectrum::zero(),
         weighted: SampledSpectrum::zero(),
@@ -132,24 +132,25 @@ fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Cont
     };
     if v.at_infinity() {
         for &id in cx.scene.infinite_lights() {
-            let mut e = v;
+            let mut e = *v;
             e.kind = VertexKind::Light(id);
             add(e);
         }
     } else if v.area_light.is_some() {
-        add(v);
+        add(*v);
     }
     (!out.unweighted.is_black()).then_some(out)
 }
 
 /// t = 1: connects light vertex s − 1 to a sampled lens point.
-fn connect_camera<'a>(
+fn connect_camera<R>(
     cx: &ConnectCtx<'_>,
-    light: &'a [Vertex],
-    cam: &'a [Vertex],
+    light: &[Vertex],
+    cam: &[Vertex],
     s: usize,
     sampler: &mut Sampler,
-) -> Option<(Unweighted, PathView<'a>)> {
+    k: impl FnOnce(Unweighted, &PathView<'_>) -> R,
+) -> Option<R> {
     let v = &light[s - 1];
     let u = sampler.get_2d();
     if !cx.camera.is_connectable() {
@@ -192,17 +193,18 @@ fn connect_camera<'a>(
         light_end: None,
         cam_end: Some(lens),
     };
-    Some(((c, Some(cs.p_raster)), view))
+    Some(k((c, Some(cs.p_raster)), &view))
 }
 
 /// s = 1: next-event estimation from camera vertex t − 1 ([`sample_light`]).
-fn connect_light<'a>(
+fn connect_light<R>(
     cx: &ConnectCtx<'_>,
-    light: &'a [Vertex],
-    cam: &'a [Vertex],
+    light: &[Vertex],
+    cam: &[Vertex],
     t: usize,
     sampler: &mut Sampler,
-) -> Option<(Unweighted, PathView<'a>)> {
+    k: impl FnOnce(Unweighted, &PathView<'_>) -> R,
+) -> Option<R> {
     let v = &cam[t - 1];
     let r = Receiver::at_vertex(v)?;
     let ls = sample_light(cx.scene, cx.scene.light_sampler(), &r, cx.lambda, sampler)?;
@@ -220,17 +222,18 @@ fn connect_light<'a>(
         light_end: Some(e),
         cam_end: None,
     };
-    Some(((c, None), view))
+    Some(k((c, None), &view))
 }
 
 /// s, t ≥ 2: joins two surface vertices with a shadow ray.
-fn connect_inner<'a>(
+fn connect_inner<R>(
     cx: &ConnectCtx<'_>,
-    light: &'a [Vertex],
-    cam: &'a [Vertex],
+    light: &[Vertex],
+    cam: &[Vertex],
     s: usize,
     t: usize,
-) -> Option<(Unweighted, PathView<'a>)> {
+    k: impl FnOnce(Unweighted, &PathView<'_>) -> R,
+) -> Option<R> {
     let (lv, cv) = (&light[s - 1], &cam[t - 1]);
     let (lb, cb) = (lv.bsdf.as_ref()?, cv.bsdf.as_ref()?);
     if !lb.flags().is_non_specular() || !cb.flags().is_non_specular() {
@@ -255,5 +258,5 @@ fn connect_inner<'a>(
         light_end: None,
         cam_end: None,
     };
-    Some(((c, None), view))
+    Some(k((c, None), &view))
 }

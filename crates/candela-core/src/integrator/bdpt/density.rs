@@ -37,6 +37,26 @@ fn pdf_scatter(cur: &Vertex, prev: &Vertex, next: &Vertex, mode: TransportMode) 
     to_area(bsdf.pdf(wo, wi, mode, SampleFlags::ALL), cur, next).0
 }
 
+/// Both densities of surface vertex `cur` between `prev` and `next` from one
+/// frame change per direction: (`pdf(cur, Some(prev), next, mode)`,
+/// `pdf(cur, Some(next), prev, mode.adjoint())`), bit for bit what the two
+/// calls give ([`crate::bsdf::Bsdf::pdfs_pair`]): what the MIS weights
+/// need at each end of a connection.
+pub(crate) fn pdf_scatter_pair(
+    cur: &Vertex,
+    prev: &Vertex,
+    next: &Vertex,
+    mode: TransportMode,
+) -> (f32, f32) {
+    debug_assert!(cur.kind == VertexKind::Surface);
+    let Some(bsdf) = &cur.bsdf else {
+        return (0.0, 0.0);
+    };
+    let pair = bsdf.local_pair(dir(cur, prev), dir(cur, next));
+    let (fwd, rev) = bsdf.pdfs_pair(&pair, mode);
+    (to_area(fwd, cur, next).0, to_area(rev, cur, prev).0)
+}
+
 /// Density of the camera's ray from lens point `cur` through `next`.
 fn pdf_camera(camera: &Camera, cur: &Vertex, next: &Vertex) -> f32 {
     let ray = Ray::new(cur.p(), dir(cur, next));

@@ -16,10 +16,10 @@
 //! The densities next to the connection are unknown to either subpath and
 //! are computed here; all others were stored by the random walks.
 
-use super::density::{pdf, pdf_light_origin};
+use super::density::{pdf, pdf_light_origin, pdf_scatter_pair};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
-use crate::integrator::subpath::Vertex;
+use crate::integrator::subpath::{Vertex, VertexKind};
 use crate::light::LightType;
 use crate::scene::Scene;
 
@@ -68,6 +68,7 @@ impl PathView<'_> {
     }
 
     /// Vertex i counted from the light end.
+    #[inline]
     pub fn get(&self, i: usize) -> &Vertex {
         if i < self.s {
             match &self.light_end {
@@ -84,7 +85,94 @@ impl PathView<'_> {
     }
 }
 
-/// p_L and p_E of one path: stored densities plus the ones the connection creates.
+/// The densities only the connection of strategy (s, t) determines:
+/// p_L[s] (at s = 0 the emitter's origin density p_L[0]), p_L[s + 1],
+/// p_E[s − 1] and p_E[s − 2], where they exist.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct JoinDensities {
+    /// p_L[s], p_L[s + 1].
+    pub p_light: [f32; 2],
+    /// p_E[s − 1], p_E[s − 2].
+    pub p_eye: [f32; 2],
+}
+
+impl JoinDensities {
+    /// Computes them for `view`; at a surface vertex with both neighbours the
+    /// two densities of a connection end come from one pair evaluation
+    /// ([`pdf_scatter_pair`]).
+    pub fn of(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
+        let (n, s) = (view.n(), view.s);
+        let (imp, rad) = (TransportMode::Importance, TransportMode::Radiance);
+        let x = |i: usize| view.get(i);
+        let surface = |i: usize| x(i).kind == VertexKind::Surface;
+        let mut j = Self::default();
+        if s == 0 {
+            j.p_light[0] = pdf_light_origin(scene, x(0), x(1));
+        } else if s >= 2 && surface(s - 1) {
+            (j.p_light[0], j.p_eye[1]) = pdf_scatter_pair(x(s - 1), x(s - 2), x(s), imp);
+        } else {
+            let prev = (s >= 2).then(|| x(s - 2));
+            j.p_light[0] = pdf(scene, camera, x(s - 1), prev, x(s), imp);
+            if s >= 2 {
+                j.p_eye[1] = pdf(scene, camera, x(s - 1), Some(x(s)), x(s - 2), rad);
+            }
+        }
+        if s >= 1 && view.t >= 2 && surface(s) {
+            (j.p_eye[0], j.p_light[1]) = pdf_scatter_pair(x(s), x(s + 1), x(s - 1), rad);
+            return j;
+        }
+        if s >= 1 {
+            let prev = (view.t >= 2).then(|| x(s + 1));
+            j.p_eye[0] = pdf(scene, camera, x(s), prev, x(s - 1), rad);
+        }
+        if s + 1 < n {
+            let prev = (s >= 1).then(|| x(s - 1));
+            j.p_light[1] = pdf(scene, camera, x(s), prev, x(s + 1), imp);
+        }
+        j
+    }
+
+    /// p_L[i] of `view`: these where the connection determines it, the
+    /// walks' stored densities elsewhere.
+    #[inline]
+    fn p_light(&self, view: &PathView<'_>, i: usize) -> f32 {
+        let s = view.s;
+        if i == s {
+            self.p_light[0]
+        } else if i == s + 1 {
+            self.p_light[1]
+        } else if i < s {
+            view.get(i).pdf_fwd.0
+        } else {
+            view.get(i).pdf_rev.0
+        }
+    }
+
+    /// p_E[i] of `view` (as [`Self::p_light`]).
+    #[inline]
+    fn p_eye(&self, view: &PathView<'_>, i: usize) -> f32 {
+        let s = view.s;
+        if i + 1 == s {
+            self.p_eye[0]
+        } else if i + 2 == s {
+            self.p_eye[1]
+        } else if i < s {
+            view.get(i).pdf_rev.0
+        } else {
+            view.get(i).pdf_fwd.0
+        }
+    }
+}
+
+/// Whether x_i of `view` is specular (the connection endpoints never are).
+#[inline]
+fn is_delta(view: &PathView<'_>, i: usize) -> bool {
+    view.get(i).delta && i + 1 != view.s && i != view.s
+}
+
+/// p_L and p_E of one path gathered into arrays: the reference form of
+/// what [`mis_weight`] reads in place, for the tests.
+#[cfg(test)]
 #[derive(Default)]
 pub(crate) struct PathDensities {
     /// p_L[i].
@@ -95,59 +183,67 @@ pub(crate) struct PathDensities {
     pub delta: Vec<bool>,
 }
 
+#[cfg(test)]
 impl PathDensities {
-    /// Gathers the densities of `view`, computing the four (at s = 0: three
-    /// plus the emitter's origin density) that depend on the connection.
-    #[cfg(test)]
+    /// Gathers the densities of `view`: stored ones and [`JoinDensities`].
     pub fn of(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
-        let mut d = Self::default();
-        d.fill(scene, camera, view);
-        d
-    }
-
-    /// Refills `self` for `view`, reusing its buffers.
-    pub fn fill(&mut self, scene: &Scene, camera: &Camera, view: &PathView<'_>) {
-        let (n, s) = (view.n(), view.s);
-        let Self {
-            p_light,
-            p_eye,
-            delta,
-        } = self;
-        p_light.clear();
-        p_eye.clear();
-        delta.clear();
-        for i in 0..n {
-            let v = view.get(i);
-            if i < s {
-                p_light.push(v.pdf_fwd.0);
-                p_eye.push(v.pdf_rev.0);
-            } else {
-                p_light.push(v.pdf_rev.0);
-                p_eye.push(v.pdf_fwd.0);
-            }
-            delta.push(v.delta && i + 1 != s && i != s);
-        }
-        let (imp, rad) = (TransportMode::Importance, TransportMode::Radiance);
-        let x = |i: usize| view.get(i);
-        if s == 0 {
-            p_light[0] = pdf_light_origin(scene, x(0), x(1));
-        } else {
-            let prev = (s >= 2).then(|| x(s - 2));
-            p_light[s] = pdf(scene, camera, x(s - 1), prev, x(s), imp);
-            let prev = (view.t >= 2).then(|| x(s + 1));
-            p_eye[s - 1] = pdf(scene, camera, x(s), prev, x(s - 1), rad);
-        }
-        if s + 1 < n {
-            let prev = (s >= 1).then(|| x(s - 1));
-            p_light[s + 1] = pdf(scene, camera, x(s), prev, x(s + 1), imp);
-        }
-        if s >= 2 {
-            p_eye[s - 2] = pdf(scene, camera, x(s - 1), Some(x(s)), x(s - 2), rad);
+        let j = JoinDensities::of(scene, camera, view);
+        let n = view.n();
+        Self {
+            p_light: (0..n).map(|i| j.p_light(view, i)).collect(),
+            p_eye: (0..n).map(|i| j.p_eye(view, i)).collect(),
+            delta: (0..n).map(|i| is_delta(view, i)).collect(),
         }
     }
 }
 
-/// Whether strategy k (k light vertices, n − k camera vertices) can make the path.
+/// Which strategies can make a path of n vertices starting at x0: the
+/// conditions that do not depend on k, evaluated once per path.
+pub(crate) struct Strategies {
+    n: usize,
+    /// k = 0 needs a hittable emitter at x0.
+    x0_hittable: bool,
+    /// k = n − 1 (t = 1) needs a camera that can be connected to and, when
+    /// also k = 1, a visible area light at x0.
+    last_ok: bool,
+}
+
+impl Strategies {
+    /// The strategies of a path of `n` vertices whose light end is `x0`.
+    pub fn new(scene: &Scene, camera: &Camera, x0: &Vertex, n: usize) -> Self {
+        let last_ok = camera.is_connectable()
+            && (n != 2
+                || x0.light_id().is_some_and(|id| {
+                    // s = 1, t = 1: only a visible area light can be seen directly.
+                    let l = scene.light(id);
+                    l.light_type() == LightType::Area && l.is_hittable()
+                }));
+        Self {
+            n,
+            x0_hittable: x0.is_hittable_light(scene),
+            last_ok,
+        }
+    }
+
+    /// Whether strategy k (k light vertices, n − k camera vertices) can make
+    /// the path whose specular flags `delta(i)` gives.
+    #[inline(always)]
+    pub fn valid(&self, delta: impl Fn(usize) -> bool, k: usize) -> bool {
+        if k >= self.n {
+            return false; // t = 0: candela never hits the lens.
+        }
+        if k == 0 {
+            return self.x0_hittable;
+        }
+        if delta(k - 1) || delta(k) {
+            return false;
+        }
+        k != self.n - 1 || self.last_ok
+    }
+}
+
+/// [`Strategies::valid`] with the flags in a slice.
+#[cfg(test)]
 pub(crate) fn strategy_valid(
     scene: &Scene,
     camera: &Camera,
@@ -155,33 +251,12 @@ pub(crate) fn strategy_valid(
     delta: &[bool],
     k: usize,
 ) -> bool {
-    let n = delta.len();
-    if k >= n {
-        return false; // t = 0: candela never hits the lens.
-    }
-    if k == 0 {
-        return x0.is_hittable_light(scene);
-    }
-    if delta[k - 1] || delta[k] {
-        return false;
-    }
-    if k == n - 1 {
-        if !camera.is_connectable() {
-            return false;
-        }
-        if k == 1 {
-            // s = 1, t = 1: only a visible area light can be seen directly.
-            let area = x0.light_id().is_some_and(|id| {
-                let l = scene.light(id);
-                l.light_type() == LightType::Area && l.is_hittable()
-            });
-            return area;
-        }
-    }
-    true
+    Strategies::new(scene, camera, x0, delta.len()).valid(|i| delta[i], k)
 }
 
-/// MIS weight of strategy `s` for the path with densities `d`.
+/// MIS weight of strategy `s` for the path with densities `d` (the
+/// reference form of [`mis_weight`]).
+#[cfg(test)]
 pub(crate) fn weight_from_densities(
     scene: &Scene,
     camera: &Camera,
@@ -213,14 +288,37 @@ pub(crate) fn weight_from_densities(
     1.0 / sum
 }
 
-/// MIS weight of the strategy that made `view`; `scratch` is reused storage.
+/// MIS weight of the strategy that made `view`: the ratios p_k/p_s walked
+/// outward from k = s (module doc), reading the walks' densities in place.
 pub(crate) fn mis_weight(
     scene: &Scene,
     camera: &Camera,
     view: &PathView<'_>,
     h: MisHeuristic,
-    scratch: &mut PathDensities,
 ) -> f32 {
-    scratch.fill(scene, camera, view);
-    weight_from_densities(scene, camera, view.get(0), scratch, view.s, h)
+    let (n, s) = (view.n(), view.s);
+    let j = JoinDensities::of(scene, camera, view);
+    let x0 = view.get(0);
+    let strategies = Strategies::new(scene, camera, x0, n);
+    let valid = |k: usize| strategies.valid(|i| is_delta(view, i), k);
+    let remap0 = |p: f32| if p != 0.0 { p } else { 1.0 };
+    let mut sum = 1.0f32;
+    let mut r = 1.0f32;
+    for k in s + 1..n {
+        r *= remap0(j.p_light(view, k - 1)) / remap0(j.p_eye(view, k - 1));
+        if valid(k) {
+            sum += h.apply(r);
+        }
+    }
+    r = 1.0;
+    for k in (0..s).rev() {
+        r *= remap0(j.p_eye(view, k)) / remap0(j.p_light(view, k));
+        if valid(k) {
+            sum += h.apply(r);
+        }
+    }
+    if !sum.is_finite() {
+        return 0.0;
+    }
+    1.0 / sum
 }

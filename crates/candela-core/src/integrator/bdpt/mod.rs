@@ -34,11 +34,25 @@ use super::{
     RenderContext,
 };
 use crate::film::{PassBlock, SplatBuffer};
+use crate::integrator::subpath::Vertex;
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use connect::{connect, ConnectCtx, Contribution};
+use std::cell::RefCell;
 use walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
+
+/// Storage every sample of a thread reuses: both subpaths (no allocation
+/// per sample once the buffers have grown).
+#[derive(Default)]
+struct Scratch {
+    cam: Vec<Vertex>,
+    light: Vec<Vertex>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::default();
+}
 
 /// Parameters of `Integrator "bdpt"`.
 #[derive(Clone, Debug)]
@@ -130,8 +144,24 @@ impl BdptIntegrator {
         sampler: &mut Sampler,
         mut visit: impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
     ) {
+        SCRATCH.with(|cell| {
+            let mut scratch = cell.borrow_mut();
+            self.sample_strategies_in(ctx, ray, lambda, sampler, &mut scratch, &mut visit);
+        });
+    }
+
+    /// [`Self::sample_strategies`] with the thread's reused buffers.
+    fn sample_strategies_in(
+        &self,
+        ctx: &RenderContext<'_>,
+        ray: Ray,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+        visit: &mut impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
+    ) {
         let max_depth = self.settings.max_depth as usize;
-        let (mut cam, mut light) = (Vec::new(), Vec::new());
+        let Scratch { cam, light } = scratch;
         let walk = |max_vertices| WalkSettings {
             max_vertices,
             regularize: self.settings.regularize,
@@ -143,24 +173,16 @@ impl BdptIntegrator {
             lambda,
             sampler,
             walk(max_depth + 1),
-            &mut cam,
+            cam,
         );
         let time = ray.time;
-        generate_light_subpath(
-            ctx.scene,
-            time,
-            lambda,
-            sampler,
-            walk(max_depth),
-            &mut light,
-        );
+        generate_light_subpath(ctx.scene, time, lambda, sampler, walk(max_depth), light);
         let lambda = *lambda;
         let cx = ConnectCtx {
             scene: ctx.scene,
             camera: ctx.camera,
             lambda: &lambda,
             heuristic: self.settings.heuristic,
-            scratch: Default::default(),
         };
         // s = 1 resamples the light (`connect_light`) and does not use the
         // light subpath, so it runs even when that subpath is empty because
@@ -177,7 +199,7 @@ impl BdptIntegrator {
                 if s > light.len() && t == 1 {
                     continue; // s = 1, t = 1 joins the subpath's own vertex.
                 }
-                if let Some(c) = connect(&cx, &light, &cam, s, t, sampler) {
+                if let Some(c) = connect(&cx, light, cam, s, t, sampler) {
                     visit(s, t, &c, &lambda);
                 }
             }

@@ -11,7 +11,9 @@
 
 use super::connect::{strategy, ConnectCtx};
 use super::density::{pdf, pdf_light_origin};
-use super::mis::{strategy_valid, weight_from_densities, MisHeuristic, PathDensities, PathView};
+use super::mis::{
+    mis_weight, strategy_valid, weight_from_densities, MisHeuristic, PathDensities, PathView,
+};
 use super::walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
 use crate::bsdf::TransportMode;
 use crate::build::{build, Overrides, RenderSetup};
@@ -180,7 +182,18 @@ fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut 
         view.s,
         view.t
     );
-    let w = weight_from_densities(&rs.scene, &rs.camera, x0, &used, view.s, h) as f64;
+    let w = weight_from_densities(&rs.scene, &rs.camera, x0, &used, view.s, h);
+    // The renderer reads the densities in place instead of gathering them:
+    // the same operations in the same order, so the same bits.
+    let in_place = mis_weight(&rs.scene, &rs.camera, view, h);
+    assert_eq!(
+        in_place.to_bits(),
+        w.to_bits(),
+        "in-place weight {in_place} vs gathered {w} (s={}, t={})",
+        view.s,
+        view.t
+    );
+    let w = w as f64;
     let beta = if h == MisHeuristic::Power { 2 } else { 1 };
     let wb = product_weight(rs, x0, &brute, view.s, beta);
     assert!(
@@ -272,7 +285,6 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
             camera: &rs.camera,
             lambda: &lambda,
             heuristic: h,
-            scratch: Default::default(),
         };
         for t in 1..=cam.len() {
             for s in 0..=light.len() {
@@ -283,10 +295,12 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
                     for view in emitter_views(&rs, &cam, t) {
                         check_view(&rs, &view, h, &mut cov);
                     }
-                } else if let Some((c, view)) = strategy(&cx, &light, &cam, s, t, &mut sampler) {
-                    if !c.0.is_black() {
-                        check_view(&rs, &view, h, &mut cov);
-                    }
+                } else {
+                    strategy(&cx, &light, &cam, s, t, &mut sampler, |c, view| {
+                        if !c.0.is_black() {
+                            check_view(&rs, view, h, &mut cov);
+                        }
+                    });
                 }
             }
         }

@@ -41,7 +41,7 @@ mod start;
 mod vertex;
 
 pub use start::{start_light_subpath, LightStart};
-pub use vertex::{adjoint_cos, dir, to_area, Vertex, VertexKind};
+pub use vertex::{adjoint_cos, dir, to_area, to_area_at, EndPoint, Vertex, VertexKind};
 
 use super::roulette::Roulette;
 use crate::bsdf::{SampleFlags, TransportMode};
@@ -163,7 +163,8 @@ struct State {
     beta: SampledSpectrum,
     depth: u32,
     pdf_dir: PdfSolidAngle,
-    prev: Option<Vertex>,
+    /// What the density conversions read of the previous vertex.
+    prev: Option<EndPoint>,
     after_delta: bool,
     scattered: bool,
     any_non_specular: bool,
@@ -193,7 +194,7 @@ where
         beta: start.beta,
         depth: start.depth,
         pdf_dir: start.pdf_dir,
-        prev: start.from,
+        prev: start.from.as_ref().map(EndPoint::of),
         after_delta: true,
         scattered: false,
         any_non_specular: false,
@@ -228,10 +229,10 @@ where
         v.caustic = st.scattered && !st.any_non_specular;
         if V::DENSITIES {
             v.pdf_fwd = match &st.prev {
-                Some(p) if p.at_infinity() => {
+                Some(p) if p.at_infinity => {
                     PdfArea(st.pdf_dir.0 * si.n().dot(st.ray.d.normalize()).abs())
                 }
-                Some(p) => to_area(st.pdf_dir, p, &v),
+                Some(p) => to_area_at(st.pdf_dir, p.p, &EndPoint::of(&v)),
                 None => PdfArea(0.0),
             };
         }
@@ -290,7 +291,7 @@ where
             pdf_rev = PdfSolidAngle(0.0);
         }
         let prev_pdf_rev = match &st.prev {
-            Some(p) => to_area(pdf_rev, v, p),
+            Some(p) => to_area_at(pdf_rev, v.p(), p),
             None => PdfArea(0.0),
         };
         visitor.scattered(&Scatter {
@@ -301,7 +302,7 @@ where
             prev_pdf_rev,
         });
         st.pdf_dir = pdf_fwd;
-        st.prev = Some(*v);
+        st.prev = Some(EndPoint::of(v));
     } else if bs.is_specular() {
         st.pdf_dir = PdfSolidAngle(0.0);
     }

@@ -189,17 +189,49 @@ pub fn dir(from: &Vertex, to: &Vertex) -> Vec3 {
 
 /// Converts a solid-angle density at `from` into an area density at `to`
 /// [Veach 1997, eq. 8.10]: p_A = p_ω |cos θ_to| / d² (unchanged at infinity).
+#[inline]
 pub fn to_area(pdf: PdfSolidAngle, from: &Vertex, to: &Vertex) -> PdfArea {
-    if to.at_infinity() {
+    to_area_at(pdf, from.p(), &EndPoint::of(to))
+}
+
+/// What converting a density to area at a vertex reads of it: position,
+/// geometric normal (zero off surfaces) and whether it is at infinity. A
+/// walk keeps this of its previous vertex instead of a copy of the vertex.
+#[derive(Clone, Copy, Debug)]
+pub struct EndPoint {
+    /// Position.
+    pub p: Vec3,
+    /// Geometric normal (zero off surfaces).
+    pub n: Vec3,
+    /// A vertex at infinity.
+    pub at_infinity: bool,
+}
+
+impl EndPoint {
+    /// The end point of vertex `v`.
+    #[inline]
+    pub fn of(v: &Vertex) -> Self {
+        Self {
+            p: v.p(),
+            n: v.it.n,
+            at_infinity: v.at_infinity(),
+        }
+    }
+}
+
+/// [`to_area`] from position `from` to end point `to`.
+#[inline]
+pub fn to_area_at(pdf: PdfSolidAngle, from: Vec3, to: &EndPoint) -> PdfArea {
+    if to.at_infinity {
         return PdfArea(pdf.0);
     }
-    let d = to.p() - from.p();
+    let d = to.p - from;
     let d2 = d.length_squared();
     if d2 == 0.0 {
         return PdfArea(0.0);
     }
-    let cos = if to.it.is_surface() {
-        to.it.n.dot(d).abs() / d2.sqrt()
+    let cos = if to.n != Vec3::ZERO {
+        to.n.dot(d).abs() / d2.sqrt()
     } else {
         1.0
     };
