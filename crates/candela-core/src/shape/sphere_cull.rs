@@ -54,7 +54,8 @@ impl MissTest {
                 .sqrt()
         };
         let cond = frob(&render_from_object.m) * frob(&m);
-        if !affine || !(cond < 1e3) {
+        let well_conditioned = cond < 1e3; // false for NaN
+        if !affine || !well_conditioned {
             return None;
         }
         let rows = [0, 1, 2].map(|i| m.row(i).to_array().map(f64::from));
@@ -91,7 +92,8 @@ impl MissTest {
             return true;
         }
         let h2 = (r - len_f) * (r + len_f);
-        if !(h2 > MARGIN * scale * scale) {
+        let well_conditioned = h2 > MARGIN * scale * scale; // false for NaN
+        if !well_conditioned {
             return false;
         }
         // Half-chord in units of t, and the margin in those units.
