@@ -25,7 +25,7 @@ pub use independent::IndependentSampler;
 pub use sobol::PaddedSobolSampler;
 
 use crate::math::{UVec2, Vec2};
-use crate::sampling::hash_u64s;
+use crate::sampling::{hash_u64s, hash_u64s_from};
 
 /// Which sampler to build.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,12 +133,20 @@ impl Sampler {
 /// Hash of (pixel, dimension, seed) seeding a dimension's randomisation.
 #[inline]
 fn pixel_hash(pixel: UVec2, dimension: u32, seed: u64) -> u64 {
-    hash_u64s(&[
-        u64::from(pixel.x),
-        u64::from(pixel.y),
-        u64::from(dimension),
-        seed,
-    ])
+    dimension_hash(pixel_prefix(pixel), dimension, seed)
+}
+
+/// The part of [`pixel_hash`] that depends on the pixel only (a sampler
+/// computes it once per pixel sample rather than once per dimension).
+#[inline]
+fn pixel_prefix(pixel: UVec2) -> u64 {
+    hash_u64s(&[u64::from(pixel.x), u64::from(pixel.y)])
+}
+
+/// [`pixel_hash`] from the pixel's [`pixel_prefix`].
+#[inline]
+fn dimension_hash(prefix: u64, dimension: u32, seed: u64) -> u64 {
+    hash_u64s_from(prefix, &[u64::from(dimension), seed])
 }
 
 /// The top 24 bits of `v` as a float in [0, 1) (exact, never rounds up to 1).

@@ -20,7 +20,7 @@
 //! Everything is a pure function of (pixel, sample index, dimension, seed),
 //! so renders are deterministic under any thread schedule.
 
-use super::{pixel_hash, sample_from_bits};
+use super::{dimension_hash, pixel_prefix, sample_from_bits};
 use crate::math::{UVec2, Vec2};
 
 /// Generator matrix columns of Sobol dimension 1 (column j for index bit j).
@@ -114,7 +114,8 @@ pub(crate) fn permute_index(i: u32, n: u32, seed: u64) -> u32 {
 pub struct PaddedSobolSampler {
     spp: u32,
     seed: u64,
-    pixel: UVec2,
+    /// [`pixel_prefix`] of the current pixel.
+    pixel_prefix: u64,
     sample_index: u32,
     dimension: u32,
 }
@@ -125,7 +126,7 @@ impl PaddedSobolSampler {
         Self {
             spp: spp.max(1),
             seed,
-            pixel: UVec2::ZERO,
+            pixel_prefix: pixel_prefix(UVec2::ZERO),
             sample_index: 0,
             dimension: 0,
         }
@@ -143,14 +144,14 @@ impl PaddedSobolSampler {
 
     /// Positions the sampler at (pixel, sample index, first dimension).
     pub fn start_pixel_sample(&mut self, pixel: UVec2, sample_index: u32, dimension: u32) {
-        self.pixel = pixel;
+        self.pixel_prefix = pixel_prefix(pixel);
         self.sample_index = sample_index;
         self.dimension = dimension;
     }
 
     /// Hash of the current dimension and the permuted sample index.
     fn next(&mut self, used: u32) -> (u64, u32) {
-        let h = pixel_hash(self.pixel, self.dimension, self.seed);
+        let h = dimension_hash(self.pixel_prefix, self.dimension, self.seed);
         self.dimension += used;
         let index = permute_index(self.sample_index, self.spp, crate::sampling::mix_bits(h));
         (h, index)

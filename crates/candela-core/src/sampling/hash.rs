@@ -14,7 +14,13 @@ pub fn mix_bits(mut v: u64) -> u64 {
 /// Hash of a sequence of 64-bit values (order-dependent).
 #[inline]
 pub fn hash_u64s(vals: &[u64]) -> u64 {
-    let mut h = 0x9e37_79b9_7f4a_7c15u64;
+    hash_u64s_from(0x9e37_79b9_7f4a_7c15, vals)
+}
+
+/// Continues [`hash_u64s`] from the state `h` it reached on a prefix:
+/// `hash_u64s(&[a, b, c]) == hash_u64s_from(hash_u64s(&[a, b]), &[c])`.
+#[inline]
+pub fn hash_u64s_from(mut h: u64, vals: &[u64]) -> u64 {
     for &v in vals {
         h = mix_bits(
             h ^ v
@@ -52,4 +58,17 @@ pub fn murmur_hash64a(key: &[u8], seed: u64) -> u64 {
     h = h.wrapping_mul(M);
     h ^= h >> R;
     h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn continuing_from_a_prefix_equals_hashing_the_whole_sequence() {
+        let v = [3u64, 1 << 40, 7, u64::MAX, 0];
+        for k in 0..=v.len() {
+            assert_eq!(hash_u64s_from(hash_u64s(&v[..k]), &v[k..]), hash_u64s(&v));
+        }
+    }
 }

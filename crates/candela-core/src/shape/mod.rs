@@ -32,6 +32,7 @@ mod loop_subdiv;
 mod mesh;
 mod normal_bounds;
 mod sphere;
+mod sphere_cull;
 mod triangle;
 
 #[cfg(test)]

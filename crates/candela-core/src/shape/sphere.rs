@@ -18,6 +18,7 @@
 //! is the object radius times |det M|^(1/3).
 
 use super::interval::{mid3, transform_point_i, transform_vector_i, Interval};
+use super::sphere_cull::MissTest;
 use super::{
     area_sample_to_solid_angle, pdf_from_hit, ShapeIntersection, ShapeSample, ShapeSampleContext,
     ShapeSampleSa,
@@ -44,10 +45,12 @@ pub struct Sphere {
     phi_max: f32,
     /// Linear scale of the (similarity) transform.
     scale: f32,
+    /// The f64 test that rejects certain misses before the intervals.
+    miss_test: Option<MissTest>,
 }
 
 /// Object-space hit of a quadric.
-struct QuadricHit {
+pub(super) struct QuadricHit {
     t: f32,
     p_obj: Vec3,
     phi: f32,
@@ -78,6 +81,7 @@ impl Sphere {
             theta_z_max: (z_max / radius).clamp(-1.0, 1.0).acos(),
             phi_max: phi_max_deg.clamp(0.0, 360.0).to_radians(),
             scale: det.abs().cbrt(),
+            miss_test: MissTest::new(&render_from_object),
             render_from_object,
         }
     }
@@ -111,8 +115,23 @@ impl Sphere {
         self.basic_intersect(ray, t_max).is_some()
     }
 
-    /// Solves the quadratic in intervals and applies the clipping [pbrt-v4 §6.2.2].
+    /// The hit nearest the ray origin: certain misses are rejected by the
+    /// f64 [`MissTest`], the rest go to the interval solution.
     fn basic_intersect(&self, ray: &Ray, t_max: f32) -> Option<QuadricHit> {
+        if self.miss_test_culls(ray, t_max) {
+            return None;
+        }
+        self.interval_intersect(ray, t_max)
+    }
+
+    /// True when the [`MissTest`] proves the ray misses.
+    pub(super) fn miss_test_culls(&self, ray: &Ray, t_max: f32) -> bool {
+        let test = self.miss_test.as_ref();
+        test.is_some_and(|m| m.misses(self.radius, ray, t_max))
+    }
+
+    /// Solves the quadratic in intervals and applies the clipping [pbrt-v4 §6.2.2].
+    pub(super) fn interval_intersect(&self, ray: &Ray, t_max: f32) -> Option<QuadricHit> {
         let object_from_render = self.render_from_object.inverse();
         let oi = transform_point_i(&object_from_render, ray.o);
         let di = transform_vector_i(&object_from_render, ray.d);
