@@ -50,7 +50,8 @@ INTEGRATORS = ["vcm", "bdpt", "sppm", "ppm", "path"]
 LIGHT_PATHS_PER_PIXEL = {"vcm": 1, "bdpt": 1, "sppm": 1, "ppm": 1}
 MATPLOTLIB = "matplotlib==3.11.2"
 CLOSING = re.compile(
-    r"with (\d+) of \d+ passes[^:]*?(?:\((?P<status>[^)]*)\))?: load ([0-9.]+) s, render ([0-9.]+) s")
+    r"with (\d+) of \d+ passes[^:]*?(?:\((?P<status>[^()]*(?:\([^()]*\)[^()]*)*)\))?: load ([0-9.]+) s, "
+    r"render ([0-9.]+) s")
 
 
 def scaled_scene(path, scale):
