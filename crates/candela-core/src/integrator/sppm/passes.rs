@@ -224,7 +224,9 @@ pub fn photon_pass(
     n_photons: u64,
 ) -> Option<Vec<Gathered>> {
     let scene = ctx.scene;
+    // One grid per wavelength group, built side by side (each build is serial).
     let grids: Vec<SphereGrid> = (0..pw.len())
+        .into_par_iter()
         .map(|g| {
             let spheres: Vec<Sphere> = visits
                 .iter()
