@@ -147,8 +147,11 @@ def bench_scene(name, a, outdir, rows, vertex_info):
 
 
 def table(rows, vertex_info, a):
-    lines = [f"# Equal-time relMSE (scale {a.scale}, reference {a.ref_integrator} "
-             f"{a.ref_seconds:g} s{', QUICK: not the real bench' if a.quick else ''})", "",
+    given = ", ".join(a.ref)
+    reference = (f"references given: {given}; otherwise {a.ref_integrator} {a.ref_seconds:g} s" if given
+                 else f"reference {a.ref_integrator} {a.ref_seconds:g} s")
+    lines = [f"# Equal-time relMSE (scale {a.scale}, {reference}"
+             f"{', QUICK: not the real bench' if a.quick else ''})", "",
              "| scene | integrator | time limit s | passes | render s | relMSE | MAE | light paths/s |",
              "|---|---|---|---|---|---|---|---|"]
     for name, integ, t, passes, secs, err, lps, mae in rows:
