@@ -26,15 +26,15 @@
 //! the magnitudes used here).
 
 use crate::math::{Ray, Transform};
-use glam::{DVec3, Mat4};
+use glam::{DAffine3, Mat4};
 
 /// Relative margin over the f64 rounding error before the test decides.
 const MARGIN: f64 = 1e-9;
 
-/// The object-from-render rows of an affine transform, in f64.
+/// The object-from-render transform of a sphere, in f64.
 #[derive(Clone, Debug)]
 pub(super) struct MissTest {
-    rows: [[f64; 4]; 3],
+    object_from_render: DAffine3,
     /// Σ |mᵢⱼ| over the linear part, and Σ |tᵢ|: bound the magnitudes
     /// (hence the rounding) of the transformed origin's terms.
     lin_abs: f64,
@@ -58,11 +58,12 @@ impl MissTest {
         if !affine || !well_conditioned {
             return None;
         }
-        let rows = [0, 1, 2].map(|i| m.row(i).to_array().map(f64::from));
-        let lin_abs = rows.iter().flat_map(|r| &r[..3]).map(|v| v.abs()).sum();
-        let trans_abs = rows.iter().map(|r| r[3].abs()).sum();
+        let object_from_render = DAffine3::from_mat4(m.as_dmat4());
+        let lin = object_from_render.matrix3;
+        let lin_abs = (lin.x_axis.abs() + lin.y_axis.abs() + lin.z_axis.abs()).element_sum();
+        let trans_abs = object_from_render.translation.abs().element_sum();
         Some(Self {
-            rows,
+            object_from_render,
             lin_abs,
             trans_abs,
         })
@@ -72,15 +73,8 @@ impl MissTest {
     /// every `t ∈ (0, t_max]` (see the module doc).
     pub fn misses(&self, radius: f32, ray: &Ray, t_max: f32) -> bool {
         let (ro, rd) = (ray.o.as_dvec3(), ray.d.as_dvec3());
-        let apply = |v: DVec3, w: f64| {
-            let r = &self.rows;
-            DVec3::new(
-                r[0][0] * v.x + r[0][1] * v.y + r[0][2] * v.z + r[0][3] * w,
-                r[1][0] * v.x + r[1][1] * v.y + r[1][2] * v.z + r[1][3] * w,
-                r[2][0] * v.x + r[2][1] * v.y + r[2][2] * v.z + r[2][3] * w,
-            )
-        };
-        let (o, d) = (apply(ro, 1.0), apply(rd, 0.0));
+        let o = self.object_from_render.transform_point3(ro);
+        let d = self.object_from_render.transform_vector3(rd);
         let r = f64::from(radius);
         let dd = d.length_squared();
         // Ray parameter and distance from the centre of the closest point.
