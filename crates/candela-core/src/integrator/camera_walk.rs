@@ -11,9 +11,18 @@
 //!   nothing else finds the light of E S* L paths: light sampling at the
 //!   last non-specular vertex is what found the rest;
 //! - at each vertex with a non-specular lobe, direct light by next-event
-//!   estimation, light sampling alone ([`crate::integrator::nee`]: no MIS,
-//!   since the caller's photons never estimate direct light there and the
-//!   walk never counts emission after a non-delta scattering);
+//!   estimation ([`crate::integrator::nee`]). With `mis_direct` (SPPM,
+//!   PPM) it is combined with BSDF sampling by the power heuristic [Veach
+//!   1997, eq. 9.13], as pbrt-v4's SPPM camera pass does: emission found
+//!   after a non-delta scattering counts with the BSDF-sampling weight, and
+//!   where the walk ends on such a vertex (the visible point) one BSDF
+//!   sample is drawn only to look for emission at its first hit (an area
+//!   light, or the infinite lights if it escapes). Light sampling alone
+//!   cannot find the reflection of a large light in a narrow glossy lobe (a
+//!   coated floor under a sky: salt noise that SPPM's photons, which never
+//!   estimate direct light, do not fill in). Without it (the photon map,
+//!   whose final gather owns the paths beyond), light sampling alone, and
+//!   emission counts only after delta scatterings;
 //! - then the caller's `shade` says what the vertex is for and how the walk
 //!   goes on: SPPM records its visible point at the first diffuse vertex
 //!   and stops ([`Flow::Stop`]), or follows glossy and specular lobes
@@ -29,9 +38,11 @@
 
 use super::nee::{sample_light, Receiver};
 use super::subpath::{walk, Dispersion, Escape, Flow, Start, Vertex, Visitor, Walk};
-use crate::bsdf::{Bsdf, TransportMode};
-use crate::math::Ray;
-use crate::sampling::{PathRng, PdfSolidAngle};
+use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
+use crate::interaction::LightId;
+use crate::light::{LightChooser, LightSampleContext};
+use crate::math::{Ray, Vec3};
+use crate::sampling::{power_heuristic, PathRng, PdfSolidAngle};
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -42,14 +53,123 @@ pub struct CameraWalk {
     pub max_depth: u32,
     /// Also count the emission of vertex `max_depth` + 1.
     pub emission_beyond: bool,
+    /// Direct light by MIS of light and BSDF sampling (module doc).
+    pub mis_direct: bool,
+}
+
+/// The last vertex the walk left along a non-delta lobe: what the MIS
+/// weight of emission found next needs.
+#[derive(Clone, Copy)]
+struct Scattered {
+    ctx: LightSampleContext,
+    bsdf: Bsdf,
+    wo: Vec3,
+}
+
+impl Scattered {
+    fn at(v: &Vertex, bsdf: &Bsdf) -> Self {
+        Scattered {
+            ctx: LightSampleContext {
+                p: v.it.p,
+                p_error: v.it.p_error,
+                n: v.it.n,
+                ns: v.ns,
+            },
+            bsdf: *bsdf,
+            wo: v.wo,
+        }
+    }
+
+    /// The BSDF-sampling weight of light `id` reached along unit `wi`.
+    fn weight(&self, scene: &Scene, id: LightId, wi: Vec3) -> f32 {
+        let p_bsdf = self
+            .bsdf
+            .pdf(self.wo, wi, TransportMode::Radiance, SampleFlags::ALL)
+            .0;
+        bsdf_weight(scene, &self.ctx, id, wi, p_bsdf)
+    }
+}
+
+/// Power-heuristic weight of BSDF sampling (density `p_bsdf`) for light
+/// `id` reached along `wi` from `ctx`, against the NEE that could also
+/// have sampled it.
+fn bsdf_weight(scene: &Scene, ctx: &LightSampleContext, id: LightId, wi: Vec3, p_bsdf: f32) -> f32 {
+    let light = scene.light(id);
+    let p_light = scene.nee_light_sampler().choose_pmf(ctx, id) * light.pdf_li(ctx, wi).0;
+    power_heuristic(1.0, p_bsdf, 1.0, p_light)
 }
 
 /// The visitor of a camera walk.
 struct Eye<'a, F> {
     scene: &'a Scene,
     max_depth: u32,
+    /// Depth of the last vertex the walk visits.
+    walk_max_depth: u32,
+    mis: bool,
     l: SampledSpectrum,
     shade: F,
+    /// Set while the walk is between a non-delta scattering and the next vertex.
+    scattered: Option<Scattered>,
+}
+
+/// Surfaces an emission probe may cross (interface materials) before giving up.
+const PROBE_CROSSINGS: u32 = 64;
+
+impl<F> Eye<'_, F> {
+    /// Emission seen from vertex `v` along one BSDF sample of `bsdf`, at the
+    /// sample's first hit, MIS-weighted (module doc).
+    fn emission_probe<R: PathRng + ?Sized>(
+        &mut self,
+        v: &Vertex,
+        bsdf: &Bsdf,
+        lambda: &SampledWavelengths,
+        rng: &mut R,
+    ) {
+        let (u1, u2) = (rng.u1(), rng.u2());
+        let Some(bs) = bsdf.sample_f(v.wo, u1, u2, TransportMode::Radiance, SampleFlags::ALL)
+        else {
+            return;
+        };
+        let beta = v.beta * bs.f * (bs.wi.dot(bsdf.ns()).abs() / bs.pdf.0);
+        if beta.is_black() {
+            return;
+        }
+        let from = Scattered::at(v, bsdf);
+        // A delta lobe: light sampling cannot take this path, full weight.
+        let p_bsdf = (!bs.is_specular()).then(|| {
+            if bs.pdf_is_proportional {
+                bsdf.pdf(v.wo, bs.wi, TransportMode::Radiance, SampleFlags::ALL)
+                    .0
+            } else {
+                bs.pdf.0
+            }
+        });
+        let wi = bs.wi.normalize();
+        let weight = |id| p_bsdf.map_or(1.0, |p| bsdf_weight(self.scene, &from.ctx, id, wi, p));
+        let scene = self.scene;
+        let mut ray = v.it.spawn_ray(bs.wi);
+        for _ in 0..PROBE_CROSSINGS {
+            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+                for &id in scene.infinite_lights() {
+                    let le = scene.light(id).le(&ray, lambda);
+                    if !le.is_black() {
+                        self.l += beta * le * weight(id);
+                    }
+                }
+                return;
+            };
+            if let Some(id) = si.area_light {
+                let le = scene.light(id).l(si.p(), si.n(), si.it.uv, si.wo, lambda);
+                if !le.is_black() {
+                    self.l += beta * le * weight(id);
+                }
+            }
+            if !scene.is_interface(&si) {
+                return;
+            }
+            ray = si.spawn_ray(ray.d);
+        }
+    }
 }
 
 impl<R, F> Visitor<R> for Eye<'_, F>
@@ -58,10 +178,16 @@ where
     F: FnMut(&Vertex, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
 {
     fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut R) -> Flow {
-        if v.after_delta {
-            if let Some(id) = v.area_light {
+        let scattered = self.scattered.take();
+        if let Some(id) = v.area_light {
+            let weight = match &scattered {
+                _ if v.after_delta => Some(1.0),
+                Some(s) => Some(s.weight(self.scene, id, -v.wo)),
+                None => None,
+            };
+            if let Some(w) = weight {
                 let le = self.scene.light(id).l(v.p(), v.it.n, v.it.uv, v.wo, lambda);
-                self.l += v.beta * le;
+                self.l += v.beta * le * w;
             }
         }
         if v.depth > self.max_depth {
@@ -77,17 +203,38 @@ where
             if let Some(ls) =
                 sample_light(self.scene, self.scene.nee_light_sampler(), &r, lambda, rng)
             {
-                self.l += v.beta * ls.unweighted();
+                let ld = if self.mis {
+                    ls.bsdf_mis_weighted(self.scene, &r)
+                } else {
+                    ls.unweighted()
+                };
+                self.l += v.beta * ld;
             }
         }
-        (self.shade)(v, bsdf, lambda, rng)
+        let flow = (self.shade)(v, bsdf, lambda, rng);
+        if self.mis {
+            if flow == Flow::Stop || v.depth >= self.walk_max_depth {
+                self.emission_probe(v, bsdf, lambda, rng);
+            } else {
+                self.scattered = Some(Scattered::at(v, bsdf));
+            }
+        }
+        flow
     }
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
-        if e.after_delta {
-            for &id in self.scene.infinite_lights() {
-                self.l += e.beta * self.scene.light(id).le(&e.ray, lambda);
-            }
+        let scattered = self.scattered.take();
+        if !e.after_delta && scattered.is_none() {
+            return;
+        }
+        let wi = e.ray.d.normalize();
+        for &id in self.scene.infinite_lights() {
+            let le = self.scene.light(id).le(&e.ray, lambda);
+            let w = match &scattered {
+                Some(s) if !e.after_delta => s.weight(self.scene, id, wi),
+                _ => 1.0,
+            };
+            self.l += e.beta * le * w;
         }
     }
 }
@@ -108,9 +255,10 @@ where
     R: PathRng + ?Sized,
     F: FnMut(&Vertex, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
 {
+    let walk_max_depth = cw.max_depth + u32::from(cw.emission_beyond);
     let w = Walk {
         mode: TransportMode::Radiance,
-        max_depth: cw.max_depth + u32::from(cw.emission_beyond),
+        max_depth: walk_max_depth,
         roulette: None,
         regularize: false,
         dispersion: Dispersion::Keep,
@@ -125,8 +273,11 @@ where
     let mut eye = Eye {
         scene,
         max_depth: cw.max_depth,
+        walk_max_depth,
+        mis: cw.mis_direct,
         l: SampledSpectrum::zero(),
         shade,
+        scattered: None,
     };
     walk(scene, lambda, rng, &w, start, &mut eye);
     eye.l

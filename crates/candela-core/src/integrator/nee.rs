@@ -15,9 +15,11 @@
 //! their weights:
 //! - the path tracer, MIS against BSDF sampling with the power heuristic
 //!   ([`LightSample::bsdf_mis_weighted`]);
-//! - the photon estimators' camera side (SPPM, PPM, photon map), none: their
-//!   camera paths never continue along a non-specular lobe, so nothing else
-//!   samples these paths;
+//! - SPPM's and PPM's camera side, the same weight, with one BSDF sample
+//!   at the visible point that looks only for emission
+//!   ([`crate::integrator::camera_walk`]);
+//! - the photon map's camera side, none: its camera paths never continue
+//!   along a non-specular lobe, so nothing else samples these paths;
 //! - BDPT's s = 1 strategy, its MIS over all strategies.
 //!
 //! Both random numbers are drawn first, whatever the outcome, so a caller's

@@ -249,6 +249,11 @@ impl Scene {
         m.bsdf(si, lambda)
     }
 
+    /// True when the hit's material is an interface (no BSDF: rays cross it).
+    pub fn is_interface(&self, si: &SurfaceInteraction) -> bool {
+        matches!(self.resolve_material(si), None | Some(Material::Interface))
+    }
+
     /// The hit's material with mixes resolved (the builder rejects cycles;
     /// the bound guards against them anyway).
     fn resolve_material(&self, si: &SurfaceInteraction) -> Option<&Material> {

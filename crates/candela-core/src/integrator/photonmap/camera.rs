@@ -41,6 +41,7 @@ impl CameraSide<'_> {
         let cw = CameraWalk {
             max_depth: self.settings.max_depth,
             emission_beyond: true,
+            mis_direct: false,
         };
         let mut l = SampledSpectrum::zero();
         let one = SampledSpectrum::one();

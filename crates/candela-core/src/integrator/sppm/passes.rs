@@ -4,9 +4,10 @@
 //! 1. `camera_pass`: one camera path per pixel (the shared camera walk,
 //!    [`crate::integrator::camera_walk`]) follows specular (and, before
 //!    the last bounce, glossy) scattering, adds emission seen directly or
-//!    through specular chains and next-event direct lighting at every
-//!    non-specular vertex, and stops at the first diffuse vertex (or a glossy
-//!    one at depth maxdepth), which becomes the pixel's *visible point*.
+//!    through specular chains and direct light at every non-specular vertex
+//!    (light and BSDF sampling under MIS, as pbrt-v4's camera pass), and
+//!    stops at the first diffuse vertex (or a glossy one at depth maxdepth),
+//!    which becomes the pixel's *visible point*.
 //! 2. `photon_pass`: photons from [`crate::integrator::photon`] that reach a
 //!    surface after at least one bounce (direct light is the camera pass's
 //!    job) add β·f(x, ωp → ωo) to every visible point whose sphere contains
@@ -156,6 +157,7 @@ fn visit_pixel(
     let cw = CameraWalk {
         max_depth,
         emission_beyond: false,
+        mis_direct: true,
     };
     let beta = SampledSpectrum::splat(cs.ray_weight);
     let mut vp = None;
