@@ -20,21 +20,25 @@
 //! * visible points: N_pix · (size of a pixel visit + a grid sphere of 16
 //!   bytes + its radius) and up to 8 grid entries each (cells of twice the
 //!   radius: a sphere spans at most 2 × 2 × 2) of 20 bytes, plus a 4-byte
-//!   bucket per entry;
-//! * the photon–point contributions, 20 bytes each: N_photons photons, each
+//!   bucket per entry; with G > 1 wavelength groups, G BSDF slots a pixel
+//!   (a visible point seen directly is weighed at every group's
+//!   wavelengths);
+//! * the photon–point contributions, 24 bytes each: N_photons photons, each
 //!   stored once after its first bounce (a lower bound: a photon stores one
 //!   record per bounce after the first), each inside
 //!   k = min(N_pix, N_pix · πr² / A) visible points' disks, with A the surface
 //!   area of the scene's bounding box (the visible surface of a closed room);
 //! * SPPM's per-pixel statistics, 64 bytes a pixel, and the per-pixel
-//!   gathered sums, 24 bytes.
+//!   gathered sums, 16 bytes per group and 8 for the count.
 //!
-//! On the Cornell box at 256² with r = 1 this estimates 11 GB against the
-//! 7.9 GB measured; at r = 0.035 it estimates 40 MB.
+//! On the Cornell box at 256² with r = 1 this estimates 13 GB (11 GB at the
+//! 20 bytes a contribution took when 7.9 GB was measured); at r = 0.035,
+//! about 40 MB.
 
 use super::budget::Budget;
 use super::check::Check;
 use super::BuildError;
+use crate::bsdf::Bsdf;
 use crate::camera::{Camera, CameraSample};
 use crate::film::Film;
 use crate::integrator::photonmap::Photon;
@@ -204,13 +208,21 @@ pub fn claim_progressive(
     ck: &Check<'_>,
     radius: f32,
     photons: u64,
+    groups: u32,
     scale: &SceneScale,
     budget: &mut Budget,
     warnings: &mut Vec<String>,
 ) -> Result<(), BuildError> {
     let n = scale.pixels as f64;
+    let g = f64::from(groups.max(1));
     let visit = std::mem::size_of::<PixelVisit>() as f64 + 20.0;
-    let points = n * (visit + 8.0 * (20.0 + 4.0) + 64.0 + 24.0);
+    let group_bsdfs = if groups > 1 {
+        g * std::mem::size_of::<Option<Bsdf>>() as f64
+    } else {
+        0.0
+    };
+    let sums = 16.0 * g + 8.0;
+    let points = n * (visit + group_bsdfs + 8.0 * (20.0 + 4.0) + 64.0 + sums);
     budget
         .claim(
             points as u64,
@@ -232,7 +244,7 @@ pub fn claim_progressive(
     };
     budget
         .claim(
-            (pairs * 20.0).min(u64::MAX as f64) as u64,
+            (pairs * 24.0).min(u64::MAX as f64) as u64,
             &format!(
                 "the photon contributions of one iteration ({photons} photons, each in the disks of about {:.0} visible points of radius {radius})",
                 scale.points_per_photon(radius)

@@ -30,7 +30,7 @@ pub use ppm::{ppm_radius2, PpmIntegrator, PpmSettings};
 use super::photon::ShootSettings;
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
-use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, PixelVisit, VisitBuffer};
+use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, VisitBuffer, Visits};
 
 /// α of the radius reduction (Hachisuka & Jensen recommend 2/3).
 pub const ALPHA: f64 = 2.0 / 3.0;
@@ -79,30 +79,37 @@ impl SppmIntegrator {
         ctx: &RenderContext<'_>,
         pass: u64,
         st: &mut SppmState,
-        visits: &mut Vec<PixelVisit>,
+        out: &mut Visits,
     ) -> PassOutcome {
         let s = &self.settings;
         let pixels = pixel_list(ctx.film);
         let pw = pass_wavelengths(s.seed, pass, s.wavelength_groups);
-        if camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth, visits).is_none() {
+        if camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth, out).is_none() {
             return PassOutcome::Cancelled;
         }
-        let visits: &[PixelVisit] = visits;
+        let out: &Visits = out;
         let radius: Vec<f32> = st.stats.iter().map(|p| p.r2.sqrt() as f32).collect();
         let n = st.photons_per_iteration;
-        let Some(gathered) = photon_pass(ctx, visits, &radius, &pw, &s.shoot(), pass, n) else {
+        let Some(gathered) = photon_pass(ctx, out, &radius, &pw, &s.shoot(), pass, n) else {
             return PassOutcome::Cancelled;
         };
-        for ((p, v), g) in st.stats.iter_mut().zip(visits).zip(&gathered) {
-            let ld = ctx.film.sensor().to_sensor_rgb(v.ld, &v.lambda);
+        let sensor = ctx.film.sensor();
+        for (j, (p, v)) in st.stats.iter_mut().zip(&out.visits).enumerate() {
+            let ld = sensor.to_sensor_rgb(v.ld, &v.lambda);
             for (sum, v) in p.ld.iter_mut().zip(ld) {
                 *sum += v as f64;
             }
-            let phi = match &v.vp {
-                Some(vp) if g.m > 0 => ctx.film.sensor().to_sensor_rgb(vp.beta * g.phi, &v.lambda),
-                _ => [0.0; 3],
-            };
-            *p = sppm_update(p, g.m as f64, phi.map(|v| v as f64), ALPHA);
+            let m = gathered.m(j);
+            let mut phi = [0.0f64; 3];
+            if let (Some(vp), true) = (&v.vp, m > 0) {
+                for (sum, lambda) in gathered.sums(j, v, &pw) {
+                    let rgb = sensor.to_sensor_rgb(vp.beta * sum, lambda);
+                    for (c, x) in phi.iter_mut().zip(rgb) {
+                        *c += x as f64;
+                    }
+                }
+            }
+            *p = sppm_update(p, m as f64, phi, ALPHA);
         }
         PassOutcome::Done
     }

@@ -20,10 +20,20 @@
 //! neither a curved surface nor a room's edges lose photons.
 //!
 //! Wavelengths come in stratified groups ([`crate::integrator::wavelengths`]):
-//! a pixel's camera path carries its group's wavelengths, photon `i` those
-//! of group `i mod G` with its power scaled by N/N_g, and a visible point
-//! gathers only the photons of its group (one sphere grid per group), so
-//! the photon sum Φ stays spectral until the pixel update converts it.
+//! a pixel's camera path carries its group's wavelengths and photon `i`
+//! those of group `i mod G`. A visible point seen directly (the first hit of
+//! the camera ray, whose throughput does not depend on wavelength) gathers
+//! the photons of *every* group: at the camera pass its BSDF is also built
+//! at the other groups' wavelengths, a photon of group h is weighed with
+//! the BSDF of group h, and each group's sum is converted to RGB with its
+//! own wavelengths. That is the average of G unbiased estimates, one per
+//! group (each photon's power scaled by N/(G·N_h)), so the point rests on
+//! all N photons of the pass while its colour noise stays its own instead
+//! of tinting the whole pass. A visible point reached through scattering
+//! (a mirror, glass) gathers only its own group's photons, with power
+//! scaled by N/N_g, as its throughput is known at its own wavelengths only.
+//! The photon sums stay spectral, per group, until the pixel update
+//! converts them.
 //! Photon chunks return their contributions as lists merged in chunk order:
 //! deterministic.
 
@@ -33,11 +43,12 @@ use crate::integrator::camera_walk::{camera_walk, CameraWalk};
 use crate::integrator::driver::camera_sample;
 use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
-use crate::integrator::subpath::Flow;
+use crate::integrator::subpath::{Flow, Vertex};
 use crate::integrator::wavelengths::PassWavelengths;
 use crate::integrator::RenderContext;
-use crate::math::{UVec2, Vec3};
+use crate::math::{Ray, UVec2, Vec3};
 use crate::sampler::Sampler;
+use crate::scene::Scene;
 use crate::spatial::{HasSphere, SphereGrid};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
@@ -57,6 +68,9 @@ pub struct VisiblePoint {
     pub beta: SampledSpectrum,
     /// The camera path left only the hero wavelength (dispersion).
     pub terminated: bool,
+    /// It gathers every group's photons (module doc); its BSDFs at the
+    /// other groups' wavelengths are in [`Visits::group_bsdfs`].
+    pub all_groups: bool,
 }
 
 /// What the camera pass found for one pixel.
@@ -94,22 +108,56 @@ pub fn pixel_list(film: &Film) -> Vec<UVec2> {
 }
 
 /// The camera pass's output, kept from pass to pass: at 240 bytes a pixel
-/// it is 42 MB for a 350×500 film, above glibc's largest mmap threshold
-/// (32 MB), so a fresh vector each pass came from a fresh mapping and paid
-/// ~10 000 page faults (and their zeroing) per pass.
+/// the visits are 42 MB for a 350×500 film, above glibc's largest mmap
+/// threshold (32 MB), so fresh vectors each pass came from fresh mappings
+/// and paid ~10 000 page faults (and their zeroing) per pass.
 #[derive(Debug, Default)]
-pub struct VisitBuffer(std::sync::Mutex<Vec<PixelVisit>>);
+pub struct Visits {
+    /// One visit per pixel, in [`pixel_list`] order.
+    pub visits: Vec<PixelVisit>,
+    /// With G > 1 groups, G slots per pixel: slot `j·G + h` holds the BSDF
+    /// of pixel `j`'s visible point at group h's wavelengths when it gathers
+    /// every group ([`VisiblePoint::all_groups`]; its own group's slot stays
+    /// empty, that BSDF is [`VisiblePoint::bsdf`]). Empty when G = 1.
+    pub group_bsdfs: Vec<Option<Bsdf>>,
+}
+
+impl Visits {
+    /// The BSDF with which visible point `j` (of group `own`) weighs a
+    /// photon of group `h`.
+    fn bsdf_for<'a>(
+        &'a self,
+        j: usize,
+        vp: &'a VisiblePoint,
+        own: usize,
+        h: usize,
+        g: usize,
+    ) -> Option<&'a Bsdf> {
+        if h == own {
+            Some(&vp.bsdf)
+        } else {
+            self.group_bsdfs.get(j * g + h)?.as_ref()
+        }
+    }
+}
+
+/// The [`Visits`] of an integrator, kept between passes.
+#[derive(Debug, Default)]
+pub struct VisitBuffer(std::sync::Mutex<Visits>);
 
 impl VisitBuffer {
     /// The buffer (passes run one at a time; a poisoned lock only means an
     /// earlier pass panicked, and the camera pass refills the buffer anyway).
-    pub fn lock(&self) -> std::sync::MutexGuard<'_, Vec<PixelVisit>> {
+    pub fn lock(&self) -> std::sync::MutexGuard<'_, Visits> {
         self.0.lock().unwrap_or_else(|e| e.into_inner())
     }
 }
 
-/// The camera pass of iteration `iter` into `visits` (one per pixel), each
-/// pixel at its group's wavelengths in `pw` (`None` if the render was
+/// Pixels per parallel work item of the camera pass.
+const PIXEL_CHUNK: usize = 64;
+
+/// The camera pass of iteration `iter` into `out` (one visit per pixel),
+/// each pixel at its group's wavelengths in `pw` (`None` if the render was
 /// cancelled meanwhile). The sampler is reset at every pixel, so the
 /// visits do not depend on how the work is split between threads.
 pub fn camera_pass(
@@ -118,39 +166,59 @@ pub fn camera_pass(
     iter: u32,
     pw: &PassWavelengths,
     max_depth: u32,
-    visits: &mut Vec<PixelVisit>,
+    out: &mut Visits,
 ) -> Option<()> {
-    pixels
-        .par_iter()
+    let g = pw.len();
+    let blank = PixelVisit::none(pw.group(0), 0);
+    out.visits.clear();
+    out.visits.resize(pixels.len(), blank);
+    out.group_bsdfs.clear();
+    if g > 1 {
+        out.group_bsdfs.resize(pixels.len() * g, None);
+    }
+    let mut extra: Vec<&mut [Option<Bsdf>]> = if g > 1 {
+        out.group_bsdfs.chunks_mut(PIXEL_CHUNK * g).collect()
+    } else {
+        Vec::new()
+    };
+    extra.resize_with(pixels.len().div_ceil(PIXEL_CHUNK), Default::default);
+    out.visits
+        .par_chunks_mut(PIXEL_CHUNK)
+        .zip(extra)
         .enumerate()
-        .map_init(
+        .for_each_init(
             || ctx.sampler.clone(),
-            |sampler, (i, &pixel)| {
-                let group = pw.pixel_group(i as u64);
-                let lambda = pw.group(group);
-                if ctx.cancelled() {
-                    return PixelVisit::none(lambda, group);
+            |sampler, (c, (visits, extra))| {
+                for (k, v) in visits.iter_mut().enumerate() {
+                    let i = c * PIXEL_CHUNK + k;
+                    let group = pw.pixel_group(i as u64);
+                    if ctx.cancelled() {
+                        *v = PixelVisit::none(pw.group(group), group);
+                        continue;
+                    }
+                    let slots = extra.get_mut(k * g..(k + 1) * g).unwrap_or_default();
+                    sampler.start_pixel_sample(pixels[i], iter, 0);
+                    *v = visit_pixel(ctx, pixels[i], pw, group, max_depth, sampler, slots);
                 }
-                sampler.start_pixel_sample(pixel, iter, 0);
-                let mut v = visit_pixel(ctx, pixel, lambda, max_depth, sampler);
-                v.group = group;
-                v
             },
-        )
-        .collect_into_vec(visits);
+        );
     (!ctx.cancelled()).then_some(())
 }
 
-/// The camera walk of one pixel: direct light on the way and the visible
-/// point at the first diffuse vertex (or a glossy one at `max_depth`).
+/// The camera walk of one pixel of group `group`: direct light on the way
+/// and the visible point at the first diffuse vertex (or a glossy one at
+/// `max_depth`); a visible point at the first hit also gets its BSDFs at
+/// the other groups' wavelengths in `slots` (G of them, or none when G = 1).
 fn visit_pixel(
     ctx: &RenderContext<'_>,
     pixel: UVec2,
-    lambda: &SampledWavelengths,
+    pw: &PassWavelengths,
+    group: usize,
     max_depth: u32,
     sampler: &mut Sampler,
+    slots: &mut [Option<Bsdf>],
 ) -> PixelVisit {
-    let mut visit = PixelVisit::none(lambda, 0);
+    let mut visit = PixelVisit::none(pw.group(group), group);
     let Some(cs) = camera_sample(ctx, pixel, sampler) else {
         return visit;
     };
@@ -174,19 +242,66 @@ fn visit_pixel(
             if !flags.contains(BxdfFlags::DIFFUSE) && !glossy_last {
                 return Flow::Continue;
             }
+            let terminated = lam.secondary_terminated();
+            let all_groups = !slots.is_empty()
+                && v.depth == 1
+                && !terminated
+                && other_group_bsdfs(ctx.scene, cs.ray, v, pw, group, slots);
             vp = Some(VisiblePoint {
                 p: v.p(),
                 wo: v.wo,
                 n: v.it.n,
                 bsdf: *bsdf,
                 beta: v.beta,
-                terminated: lam.secondary_terminated(),
+                terminated,
+                all_groups,
             });
             Flow::Stop
         },
     );
     visit.vp = vp;
     visit
+}
+
+/// Builds the BSDF of the first hit `v` of camera ray `ray` at every other
+/// group's wavelengths into `slots` (G slots, own group's left empty); false
+/// (and the slots cleared) when it cannot: the hit is not found again, or a
+/// material there is dispersive. The hit is found as the walk found it
+/// (interfaces crossed), and the material is evaluated on a fresh copy each
+/// time, so bump mapping applies once per BSDF, exactly as in the walk.
+fn other_group_bsdfs(
+    scene: &Scene,
+    ray: Ray,
+    v: &Vertex,
+    pw: &PassWavelengths,
+    group: usize,
+    slots: &mut [Option<Bsdf>],
+) -> bool {
+    let mut ray = ray;
+    let si = loop {
+        let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+            return false;
+        };
+        if !scene.is_interface(&si) {
+            break si;
+        }
+        ray = si.spawn_ray(ray.d);
+    };
+    if si.it.p != v.it.p {
+        return false;
+    }
+    for (h, slot) in slots.iter_mut().enumerate() {
+        if h == group {
+            continue;
+        }
+        let mut lambda = *pw.group(h);
+        *slot = scene.bsdf(&mut si.clone(), &mut lambda);
+        if slot.is_none() || lambda.secondary_terminated() {
+            slots.fill(None);
+            return false;
+        }
+    }
+    true
 }
 
 /// A visible point's sphere for the grid (negative radius: none).
@@ -201,89 +316,154 @@ impl HasSphere for Sphere {
     }
 }
 
-/// Photons gathered by one visible point in one pass.
-#[derive(Clone, Copy, Debug, Default)]
+/// The photons the visible points gathered in one pass.
+#[derive(Clone, Debug)]
 pub struct Gathered {
-    /// Σ β_p·f(x, ωp → ωo) over the photons inside the sphere (W, spectral).
-    pub phi: SampledSpectrum,
-    /// Number of photons inside (M).
-    pub m: u64,
+    /// Groups per pass (G).
+    groups: usize,
+    /// Σ β_p·f(x, ωp → ωo) per visible point and group, slot `j·G + h`
+    /// (W, spectral at group h's wavelengths, power scales applied).
+    phi: Vec<SampledSpectrum>,
+    /// Photons inside each visible point's sphere (M).
+    m: Vec<u64>,
+}
+
+impl Gathered {
+    /// Number of photons visible point `j` gathered (M).
+    pub fn m(&self, j: usize) -> u64 {
+        self.m[j]
+    }
+
+    /// The non-zero photon sums of visible point `j` of `visit`, each with
+    /// the wavelengths it is spectral at (the pixel's own for its group).
+    pub fn sums<'a>(
+        &'a self,
+        j: usize,
+        visit: &'a PixelVisit,
+        pw: &'a PassWavelengths,
+    ) -> impl Iterator<Item = (SampledSpectrum, &'a SampledWavelengths)> + 'a {
+        let g = self.groups;
+        self.phi[j * g..(j + 1) * g]
+            .iter()
+            .enumerate()
+            .filter(|(_, phi)| !phi.is_black())
+            .map(move |(h, phi)| {
+                let lambda = if h == visit.group {
+                    &visit.lambda
+                } else {
+                    pw.group(h)
+                };
+                (*phi, lambda)
+            })
+    }
 }
 
 /// Photons per parallel chunk.
 const CHUNK: u64 = 4096;
 
+/// Grid of the visible points whose spheres `keep` selects.
+fn grid_of(
+    visits: &[PixelVisit],
+    radius: &[f32],
+    keep: impl Fn(&PixelVisit) -> bool,
+) -> SphereGrid {
+    let spheres: Vec<Sphere> = visits
+        .iter()
+        .zip(radius)
+        .map(|(v, &r)| match v.vp {
+            Some(vp) if keep(v) => Sphere(vp.p, r),
+            _ => Sphere(Vec3::ZERO, -1.0),
+        })
+        .collect();
+    SphereGrid::build(&spheres)
+}
+
 /// Shoots `n_photons` photons of pass `pass` and gathers them at the visible
-/// points of their wavelength group, each with its own radius `radius[i]`
-/// (`None` if cancelled).
+/// points (every group's at those that take all, module doc), each with its
+/// own radius `radius[i]` (`None` if cancelled).
 pub fn photon_pass(
     ctx: &RenderContext<'_>,
-    visits: &[PixelVisit],
+    out: &Visits,
     radius: &[f32],
     pw: &PassWavelengths,
     shoot: &ShootSettings,
     pass: u64,
     n_photons: u64,
-) -> Option<Vec<Gathered>> {
+) -> Option<Gathered> {
     let scene = ctx.scene;
-    // One grid per wavelength group, built side by side (each build is serial).
-    let grids: Vec<SphereGrid> = (0..pw.len())
+    let visits = &out.visits;
+    let g = pw.len();
+    let all = |v: &PixelVisit| v.vp.is_some_and(|vp| vp.all_groups);
+    // One grid per group for the points that gather only their own group's
+    // photons, one for those that gather all; built side by side (each
+    // build is serial).
+    let grids: Vec<SphereGrid> = (0..=g)
         .into_par_iter()
-        .map(|g| {
-            let spheres: Vec<Sphere> = visits
-                .iter()
-                .zip(radius)
-                .map(|(v, &r)| match v.vp {
-                    Some(vp) if v.group == g => Sphere(vp.p, r),
-                    _ => Sphere(Vec3::ZERO, -1.0),
-                })
-                .collect();
-            SphereGrid::build(&spheres)
+        .map(|k| {
+            if k == g {
+                grid_of(visits, radius, all)
+            } else {
+                grid_of(visits, radius, |v| v.group == k && !all(v))
+            }
         })
         .collect();
-    let lists: Vec<Option<Vec<(u32, SampledSpectrum)>>> = (0..n_photons.div_ceil(CHUNK))
+    let lists: Vec<Option<Vec<(u32, u32, SampledSpectrum)>>> = (0..n_photons.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
             if ctx.cancelled() {
                 return None;
             }
-            let mut out = Vec::new();
+            let mut list = Vec::new();
             for i in c * CHUNK..((c + 1) * CHUNK).min(n_photons) {
-                let g = pw.photon_group(i);
-                let scale = pw.photon_scale(g, n_photons);
-                trace_photon(scene, pw.group(g), shoot, pass, i, |h| {
-                    if h.v.depth < 2 {
+                let h = pw.photon_group(i);
+                let own_scale = pw.photon_scale(h, n_photons);
+                let all_scale = own_scale / g as f32;
+                trace_photon(scene, pw.group(h), shoot, pass, i, |hit| {
+                    if hit.v.depth < 2 {
                         return; // direct light: the camera pass's NEE
                     }
-                    grids[g].for_each_containing(h.v.p(), |j| {
-                        if let Some(vp) = &visits[j as usize].vp {
+                    for (grid, scale) in [(&grids[h], own_scale), (&grids[g], all_scale)] {
+                        grid.for_each_containing(hit.v.p(), |j| {
+                            let v = &visits[j as usize];
+                            let Some(vp) = &v.vp else { return };
+                            let Some(bsdf) = out.bsdf_for(j as usize, vp, v.group, h, g) else {
+                                return;
+                            };
                             let r = radius[j as usize];
-                            if let Some(phi) = photon_contribution(vp, h, r) {
-                                out.push((j, phi * scale));
+                            if let Some(phi) = photon_contribution(vp, bsdf, hit, r) {
+                                list.push((j, h as u32, phi * scale));
                             }
-                        }
-                    });
+                        });
+                    }
                 });
             }
             ctx.advance(CHUNK.min(n_photons - c * CHUNK));
-            Some(out)
+            Some(list)
         })
         .collect();
-    let mut gathered = vec![Gathered::default(); visits.len()];
+    let mut gathered = Gathered {
+        groups: g,
+        phi: vec![SampledSpectrum::zero(); visits.len() * g],
+        m: vec![0; visits.len()],
+    };
     for list in lists {
-        let list = list?;
-        for (j, phi) in list {
-            let g = &mut gathered[j as usize];
-            g.phi += phi;
-            g.m += 1;
+        for (j, h, phi) in list? {
+            gathered.phi[j as usize * g + h as usize] += phi;
+            gathered.m[j as usize] += 1;
         }
     }
     Some(gathered)
 }
 
 /// β_p·f(x, ωp → ωo) of a photon hit `h` inside the sphere (radius `r`)
-/// of `vp`, or `None` when the shared gather rule does not count it.
-fn photon_contribution(vp: &VisiblePoint, h: &PhotonHit<'_>, r: f32) -> Option<SampledSpectrum> {
+/// of `vp`, with `bsdf` the point's BSDF at the photon's wavelengths, or
+/// `None` when the shared gather rule does not count it.
+fn photon_contribution(
+    vp: &VisiblePoint,
+    bsdf: &Bsdf,
+    h: &PhotonHit<'_>,
+    r: f32,
+) -> Option<SampledSpectrum> {
     let x = Surfel {
         p: vp.p,
         n: vp.n,
@@ -295,7 +475,7 @@ fn photon_contribution(vp: &VisiblePoint, h: &PhotonHit<'_>, r: f32) -> Option<S
         w: h.v.wo,
     };
     let c = gather(&x, &ph, r * r)?;
-    let f = vp.bsdf.f(vp.wo, c.wi, TransportMode::Radiance);
+    let f = bsdf.f(vp.wo, c.wi, TransportMode::Radiance);
     let mut phi = h.v.beta * f;
     if vp.terminated {
         phi = hero_only(phi, h.terminated);

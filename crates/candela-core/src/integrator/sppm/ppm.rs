@@ -9,9 +9,7 @@
 //! channels, which the film averages over passes; because the passes are
 //! independent, a render can be split into pass ranges and merged exactly.
 
-use super::passes::{
-    camera_pass, pass_wavelengths, photon_pass, pixel_list, PixelVisit, VisitBuffer,
-};
+use super::passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, VisitBuffer, Visits};
 use super::ALPHA;
 use crate::film::PassBlock;
 use crate::integrator::photon::ShootSettings;
@@ -98,22 +96,21 @@ impl Integrator for PpmIntegrator {
         if camera_pass(ctx, &pixels, pass as u32, &pw, st.max_depth, &mut guard).is_none() {
             return PassOutcome::Cancelled;
         }
-        let visits: &[PixelVisit] = &guard;
+        let out: &Visits = &guard;
         let r2 = self.radius2(pass);
         let radius = vec![r2.sqrt() as f32; pixels.len()];
-        let Some(gathered) = photon_pass(ctx, visits, &radius, &pw, &shoot, pass, n_photons) else {
+        let Some(gathered) = photon_pass(ctx, out, &radius, &pw, &shoot, pass, n_photons) else {
             return PassOutcome::Cancelled;
         };
         let norm = (1.0 / (n_photons as f64 * std::f64::consts::PI * r2)) as f32;
         let mut buf = ctx.film.splat_buffer();
-        for ((pixel, v), g) in pixels.iter().zip(visits).zip(&gathered) {
-            let mut l = v.ld;
-            if let Some(vp) = &v.vp {
-                if g.m > 0 {
-                    l += vp.beta * g.phi * norm;
+        for (j, (pixel, v)) in pixels.iter().zip(&out.visits).enumerate() {
+            buf.add_pixel(*pixel, v.ld, &v.lambda);
+            if let (Some(vp), true) = (&v.vp, gathered.m(j) > 0) {
+                for (sum, lambda) in gathered.sums(j, v, &pw) {
+                    buf.add_pixel(*pixel, vp.beta * sum * norm, lambda);
                 }
             }
-            buf.add_pixel(*pixel, l, &v.lambda);
         }
         block.add_splats(&buf);
         PassOutcome::Done
