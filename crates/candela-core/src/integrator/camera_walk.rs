@@ -135,17 +135,25 @@ impl<F> Eye<'_, F> {
             return;
         }
         let from = Scattered::at(v, bsdf);
-        // A delta lobe: light sampling cannot take this path, full weight.
-        let p_bsdf = (!bs.is_specular()).then(|| {
-            if bs.pdf_is_proportional {
-                bsdf.pdf(v.wo, bs.wi, TransportMode::Radiance, SampleFlags::ALL)
-                    .0
-            } else {
-                bs.pdf.0
-            }
-        });
         let wi = bs.wi.normalize();
-        let weight = |id| p_bsdf.map_or(1.0, |p| bsdf_weight(self.scene, &from.ctx, id, wi, p));
+        // The density only when emission is found (a layered BSDF's is a
+        // costly estimate); a delta lobe, which light sampling cannot
+        // take, has full weight.
+        let mut p_bsdf = None;
+        let mut weight = |id| {
+            if bs.is_specular() {
+                return 1.0;
+            }
+            let p = *p_bsdf.get_or_insert_with(|| {
+                if bs.pdf_is_proportional {
+                    bsdf.pdf(v.wo, bs.wi, TransportMode::Radiance, SampleFlags::ALL)
+                        .0
+                } else {
+                    bs.pdf.0
+                }
+            });
+            bsdf_weight(self.scene, &from.ctx, id, wi, p)
+        };
         let scene = self.scene;
         let mut ray = v.it.spawn_ray(bs.wi);
         for _ in 0..PROBE_CROSSINGS {
