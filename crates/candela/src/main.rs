@@ -146,6 +146,11 @@ fn diff(a: &Path, b: &Path, region: Option<[usize; 4]>) -> Result<()> {
         println!("{:<10} {:>12.6} {:>12.6} {:>10}", ch, ma[i], mb[i], ratio);
     }
     println!("relMSE (eps 0.01)  {:.6}", c.rel_mse);
+    println!(
+        "relMSE without the worst {} % of pixels  {:.6}",
+        candela_core::image::TRIM * 100.0,
+        c.rel_mse_trimmed
+    );
     println!("MAE                {:.6}", c.mae);
     let (r, bx, by) = c.worst_block;
     println!(

@@ -10,6 +10,10 @@ pub struct Comparison {
     pub mean_ratio: [f64; 3],
     /// ⟨(A − B)² / (B² + ε)⟩ with ε = 0.01, over pixels and channels.
     pub rel_mse: f64,
+    /// The same without the [`TRIM`] share of pixels with the largest
+    /// error (at least one): a robust companion for heavy-tailed noise, where
+    /// one rare sample can carry most of `rel_mse`.
+    pub rel_mse_trimmed: f64,
     /// ⟨|A − B|⟩.
     pub mae: f64,
     /// The 32×32 block (of luminance-like channel sums) whose mean ratio
@@ -39,6 +43,9 @@ pub fn non_finite(img: &RgbImage) -> Option<NonFinite> {
     })
 }
 
+/// Share of pixels [`Comparison::rel_mse_trimmed`] leaves out.
+pub const TRIM: f64 = 0.001;
+
 /// Side of the blocks in [`Comparison::worst_block`].
 pub const BLOCK: usize = 32;
 
@@ -57,18 +64,26 @@ pub fn compare(a: &RgbImage, b: &RgbImage) -> Result<Comparison, ImageError> {
             f64::NAN
         }
     });
-    let (mut rel, mut abs) = (0.0f64, 0.0f64);
+    let mut abs = 0.0f64;
+    let mut per_pixel = Vec::with_capacity(a.pixels.len());
     for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
+        let mut rel = 0.0f64;
         for c in 0..3 {
             let (x, y) = (pa[c] as f64, pb[c] as f64);
             rel += (x - y) * (x - y) / (y * y + 0.01);
             abs += (x - y).abs();
         }
+        per_pixel.push(rel);
     }
     let n = (a.pixels.len() * 3).max(1) as f64;
+    let rel: f64 = per_pixel.iter().sum();
+    per_pixel.sort_by(f64::total_cmp);
+    let drop = ((per_pixel.len() as f64 * TRIM) as usize).max(1);
+    let kept = &per_pixel[..per_pixel.len().saturating_sub(drop)];
     Ok(Comparison {
         mean_ratio,
         rel_mse: rel / n,
+        rel_mse_trimmed: kept.iter().sum::<f64>() / (kept.len() * 3).max(1) as f64,
         mae: abs / n,
         worst_block: worst_block(a, b),
     })
@@ -128,6 +143,16 @@ mod tests {
         assert!(c.mae > 0.0 && c.rel_mse > 0.0);
         let same = compare(&b, &b).unwrap();
         assert_eq!((same.rel_mse, same.mae), (0.0, 0.0));
+        // One wild pixel of 4096: it carries the relMSE, the trimmed one drops it.
+        let mut c1 = b.clone();
+        c1.pixels[100] = [1e3; 3];
+        let c1 = compare(&c1, &b).unwrap();
+        assert!(c1.rel_mse > 1.0 && c1.rel_mse_trimmed == 0.0, "{c1:?}");
+        let t = compare(&a, &b).unwrap().rel_mse_trimmed;
+        assert!(
+            t > 0.0 && t >= c.rel_mse * 0.99 && t <= c.rel_mse * 1.01,
+            "{t}"
+        );
         assert!(compare(&a, &RgbImage::new(3, 3)).is_err());
     }
 

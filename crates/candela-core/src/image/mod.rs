@@ -14,7 +14,7 @@ mod read;
 mod resize;
 
 pub use atomic::{write_atomic, write_atomic_bytes};
-pub use compare::{compare, non_finite, Comparison, NonFinite};
+pub use compare::{compare, non_finite, Comparison, NonFinite, TRIM};
 pub use exr_write::{
     encode_exr_layers, read_exr_layers, write_exr_layers, ExrAttribute, ExrAttributes, ExrChannel,
     ExrImage, ExrLayer,
