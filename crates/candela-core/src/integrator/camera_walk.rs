@@ -39,7 +39,7 @@
 use super::nee::{sample_light, Receiver};
 use super::subpath::{walk, Dispersion, Escape, Flow, Start, Vertex, Visitor, Walk};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
-use crate::interaction::LightId;
+use crate::interaction::{LightId, SurfaceInteraction};
 use crate::light::{LightChooser, LightSampleContext};
 use crate::math::{Ray, Vec3};
 use crate::sampling::{power_heuristic, PathRng, PdfSolidAngle};
@@ -183,9 +183,15 @@ impl<F> Eye<'_, F> {
 impl<R, F> Visitor<R> for Eye<'_, F>
 where
     R: PathRng + ?Sized,
-    F: FnMut(&Vertex, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
+    F: FnMut(&Vertex, &SurfaceInteraction, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
 {
-    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut R) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        si: &SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+        rng: &mut R,
+    ) -> Flow {
         let scattered = self.scattered.take();
         if let Some(id) = v.area_light {
             let weight = match &scattered {
@@ -219,7 +225,7 @@ where
                 self.l += v.beta * ld;
             }
         }
-        let flow = (self.shade)(v, bsdf, lambda, rng);
+        let flow = (self.shade)(v, si, bsdf, lambda, rng);
         if self.mis {
             if flow == Flow::Stop || v.depth >= self.walk_max_depth {
                 self.emission_probe(v, bsdf, lambda, rng);
@@ -249,7 +255,8 @@ where
 
 /// Walks the camera ray `ray` (throughput `beta`) and returns the emission
 /// and direct light it gathered; `shade` is called at every vertex with a
-/// non-specular lobe after its direct light (module doc).
+/// non-specular lobe after its direct light (module doc), with the hit the
+/// vertex was made from.
 pub fn camera_walk<R, F>(
     scene: &Scene,
     ray: Ray,
@@ -261,7 +268,7 @@ pub fn camera_walk<R, F>(
 ) -> SampledSpectrum
 where
     R: PathRng + ?Sized,
-    F: FnMut(&Vertex, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
+    F: FnMut(&Vertex, &SurfaceInteraction, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
 {
     let walk_max_depth = cw.max_depth + u32::from(cw.emission_beyond);
     let w = Walk {

@@ -23,6 +23,7 @@ use super::subpath::{start_light_subpath, walk, Dispersion, Flow, Vertex, Visito
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::{PassBlock, SplatBuffer};
+use crate::interaction::SurfaceInteraction;
 use crate::math::Vec2;
 use crate::sampling::{hash_u64s, PathRng, StreamRng};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -152,7 +153,13 @@ struct Splat<'a, 'b> {
 }
 
 impl Visitor<StreamRng> for Splat<'_, '_> {
-    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut StreamRng) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        _: &SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+        rng: &mut StreamRng,
+    ) -> Flow {
         if let Some(bsdf) = &v.bsdf {
             if bsdf.flags().is_non_specular() {
                 connect_to_camera(self.ctx, v, bsdf, lambda, rng.u2(), self.buf);

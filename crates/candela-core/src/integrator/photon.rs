@@ -26,6 +26,7 @@
 use super::roulette::Roulette;
 use super::subpath::{start_light_subpath, walk, Dispersion, End, Flow, Vertex, Visitor, Walk};
 use crate::bsdf::TransportMode;
+use crate::interaction::SurfaceInteraction;
 use crate::sampling::StreamRng;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -69,7 +70,13 @@ struct Deposit<F> {
 }
 
 impl<F: FnMut(&PhotonHit<'_>)> Visitor<StreamRng> for Deposit<F> {
-    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, _: &mut StreamRng) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        _: &SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+        _: &mut StreamRng,
+    ) -> Flow {
         let non_specular = v.bsdf.as_ref().is_some_and(|b| b.flags().is_non_specular());
         if non_specular {
             (self.on_hit)(&PhotonHit {

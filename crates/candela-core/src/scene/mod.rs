@@ -249,6 +249,16 @@ impl Scene {
         m.bsdf(si, lambda)
     }
 
+    /// The BSDF at a hit that [`Self::bsdf`] has already prepared
+    /// (differentials set, bump applied), for other wavelengths `lambda`.
+    pub fn bsdf_prepared(
+        &self,
+        si: &SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+    ) -> Option<Bsdf> {
+        self.resolve_material(si)?.bsdf(si, lambda)
+    }
+
     /// True when the hit's material is an interface (no BSDF: rays cross it).
     pub fn is_interface(&self, si: &SurfaceInteraction) -> bool {
         matches!(self.resolve_material(si), None | Some(Material::Interface))

@@ -19,6 +19,7 @@ use crate::integrator::subpath::{
     start_light_subpath, walk, Dispersion, Escape, Flow, Scatter, Start, Vertex, Visitor, Walk,
 };
 use crate::interaction::Interaction;
+use crate::interaction::SurfaceInteraction;
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -56,7 +57,13 @@ struct Store<'a> {
 impl Visitor<Sampler> for Store<'_> {
     const DENSITIES: bool = true;
 
-    fn vertex(&mut self, v: &Vertex, _: &mut SampledWavelengths, _: &mut Sampler) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        _: &SurfaceInteraction,
+        _: &mut SampledWavelengths,
+        _: &mut Sampler,
+    ) -> Flow {
         self.path.push(*v);
         Flow::Continue
     }

@@ -8,6 +8,7 @@ use super::PhotonMapSettings;
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::integrator::camera_walk::{camera_walk, CameraWalk};
 use crate::integrator::subpath::{walk, Dispersion, Flow, Start, Vertex, Visitor, Walk};
+use crate::interaction::SurfaceInteraction;
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::sampling::{PathRng, PdfSolidAngle};
@@ -52,7 +53,7 @@ impl CameraSide<'_> {
             lambda,
             sampler,
             &cw,
-            |v, bsdf, lam, s| {
+            |v, _, bsdf, lam, s| {
                 l += v.beta * self.shade(v, bsdf, lam, s, scratch);
                 Flow::SpecularOnly
             },
@@ -154,7 +155,13 @@ struct Gather<'a, 'b> {
 }
 
 impl Visitor<Sampler> for Gather<'_, '_> {
-    fn vertex(&mut self, v: &Vertex, _: &mut SampledWavelengths, _: &mut Sampler) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        _: &SurfaceInteraction,
+        _: &mut SampledWavelengths,
+        _: &mut Sampler,
+    ) -> Flow {
         if let Some(bsdf) = &v.bsdf {
             if bsdf.flags().is_non_specular() {
                 let q = self.side.query(v, bsdf);

@@ -43,10 +43,11 @@ use crate::integrator::camera_walk::{camera_walk, CameraWalk};
 use crate::integrator::driver::camera_sample;
 use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::photon::{trace_photon, PhotonHit, ShootSettings};
-use crate::integrator::subpath::{Flow, Vertex};
+use crate::integrator::subpath::Flow;
 use crate::integrator::wavelengths::PassWavelengths;
 use crate::integrator::RenderContext;
-use crate::math::{Ray, UVec2, Vec3};
+use crate::interaction::SurfaceInteraction;
+use crate::math::{UVec2, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spatial::{HasSphere, SphereGrid};
@@ -236,7 +237,7 @@ fn visit_pixel(
         &mut visit.lambda,
         sampler,
         &cw,
-        |v, bsdf, lam, _| {
+        |v, si, bsdf, lam, _| {
             let flags = bsdf.flags();
             let glossy_last = flags.contains(BxdfFlags::GLOSSY) && v.depth == max_depth;
             if !flags.contains(BxdfFlags::DIFFUSE) && !glossy_last {
@@ -246,7 +247,7 @@ fn visit_pixel(
             let all_groups = !slots.is_empty()
                 && v.depth == 1
                 && !terminated
-                && other_group_bsdfs(ctx.scene, cs.ray, v, pw, group, slots);
+                && other_group_bsdfs(ctx.scene, si, pw, group, slots);
             vp = Some(VisiblePoint {
                 p: v.p(),
                 wo: v.wo,
@@ -263,39 +264,22 @@ fn visit_pixel(
     visit
 }
 
-/// Builds the BSDF of the first hit `v` of camera ray `ray` at every other
+/// Builds the BSDF at hit `si` (prepared by the walk) at every other
 /// group's wavelengths into `slots` (G slots, own group's left empty); false
-/// (and the slots cleared) when it cannot: the hit is not found again, or a
-/// material there is dispersive. The hit is found as the walk found it
-/// (interfaces crossed), and the material is evaluated on a fresh copy each
-/// time, so bump mapping applies once per BSDF, exactly as in the walk.
+/// (and the slots cleared) when a material there is dispersive.
 fn other_group_bsdfs(
     scene: &Scene,
-    ray: Ray,
-    v: &Vertex,
+    si: &SurfaceInteraction,
     pw: &PassWavelengths,
     group: usize,
     slots: &mut [Option<Bsdf>],
 ) -> bool {
-    let mut ray = ray;
-    let si = loop {
-        let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
-            return false;
-        };
-        if !scene.is_interface(&si) {
-            break si;
-        }
-        ray = si.spawn_ray(ray.d);
-    };
-    if si.it.p != v.it.p {
-        return false;
-    }
     for (h, slot) in slots.iter_mut().enumerate() {
         if h == group {
             continue;
         }
         let mut lambda = *pw.group(h);
-        *slot = scene.bsdf(&mut si.clone(), &mut lambda);
+        *slot = scene.bsdf_prepared(si, &mut lambda);
         if slot.is_none() || lambda.secondary_terminated() {
             slots.fill(None);
             return false;

@@ -45,6 +45,7 @@ pub use vertex::{adjoint_cos, dir, to_area, to_area_at, EndPoint, Vertex, Vertex
 
 use super::roulette::Roulette;
 use crate::bsdf::{SampleFlags, TransportMode};
+use crate::interaction::SurfaceInteraction;
 use crate::math::Ray;
 use crate::sampling::{PathRng, PdfArea, PdfSolidAngle};
 use crate::scene::Scene;
@@ -147,8 +148,15 @@ pub trait Visitor<R: PathRng + ?Sized> {
     /// True when the walk must compute densities and report each [`Scatter`].
     const DENSITIES: bool = false;
 
-    /// Called at every surface vertex; says how the walk goes on.
-    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut R) -> Flow;
+    /// Called at every surface vertex, with the hit it was made from (its
+    /// BSDF built: differentials set, bump applied); says how the walk goes on.
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        si: &SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+        rng: &mut R,
+    ) -> Flow;
 
     /// Called after each scattering when [`Visitor::DENSITIES`] is true.
     fn scattered(&mut self, _s: &Scatter) {}
@@ -236,7 +244,7 @@ where
                 None => PdfArea(0.0),
             };
         }
-        let flow = visitor.vertex(&v, lambda, rng);
+        let flow = visitor.vertex(&v, &si, lambda, rng);
         if flow == Flow::Stop || st.depth >= w.max_depth {
             return End::Ended;
         }

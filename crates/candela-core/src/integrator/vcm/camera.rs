@@ -35,6 +35,7 @@ use crate::integrator::subpath::{
 };
 use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
+use crate::interaction::SurfaceInteraction;
 use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
 use crate::sampling::PathRng;
@@ -170,7 +171,13 @@ fn unfold(c: SampledSpectrum, cam: bool, light: bool) -> SampledSpectrum {
 impl Visitor<Sampler> for CameraVisitor<'_, '_> {
     const DENSITIES: bool = true;
 
-    fn vertex(&mut self, v: &Vertex, lambda: &mut SampledWavelengths, rng: &mut Sampler) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        _: &SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+        rng: &mut Sampler,
+    ) -> Flow {
         if let Some(s) = self.pending.take() {
             let cos_out = v.wo.dot(self.prev.n).abs();
             self.mis

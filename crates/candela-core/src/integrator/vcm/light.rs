@@ -26,6 +26,7 @@ use crate::integrator::subpath::{
     adjoint_cos, start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
 };
 use crate::integrator::RenderContext;
+use crate::interaction::SurfaceInteraction;
 use crate::interaction::{Interaction, LightId};
 use crate::light::LightType;
 use crate::math::{Ray, Vec3};
@@ -412,7 +413,13 @@ struct LightVisitor<'a, 'b> {
 impl Visitor<StreamRng> for LightVisitor<'_, '_> {
     const DENSITIES: bool = true;
 
-    fn vertex(&mut self, v: &Vertex, lam: &mut SampledWavelengths, rng: &mut StreamRng) -> Flow {
+    fn vertex(
+        &mut self,
+        v: &Vertex,
+        _: &SurfaceInteraction,
+        lam: &mut SampledWavelengths,
+        rng: &mut StreamRng,
+    ) -> Flow {
         if let Some(s) = self.pending.take() {
             let cos_out = v.wo.dot(self.prev.n).abs();
             self.mis
