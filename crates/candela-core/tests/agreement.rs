@@ -76,6 +76,12 @@ fn student_t_p_values_match_tables() {
     }
 }
 
+/// Σ over blocks of `a`'s variance between renders over the same of `b`'s.
+fn variance_ratio(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
+    let var = |x: &[Vec<f64>]| x.iter().map(|r| stats::mean_var(r).1).sum::<f64>();
+    var(a) / var(b)
+}
+
 /// Welch's t-test per block between two integrators' K renders.
 fn assert_agree(a: &[Vec<f64>], b: &[Vec<f64>], what: &str) {
     stats::assert_blocks_agree(a, b, what);
@@ -182,8 +188,7 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     let pt = block_means(scene, "path", 16);
     let sppm = block_means(scene, "sppm", 16);
     assert_agree(&pt, &sppm, "glossy floor PT vs SPPM");
-    let var = |b: &[Vec<f64>]| b.iter().map(|x| stats::mean_var(x).1).sum::<f64>();
-    let ratio = var(&sppm) / var(&pt);
+    let ratio = variance_ratio(&sppm, &pt);
     assert!(
         ratio < 3.0,
         "SPPM block variance {ratio:.2}× the path tracer's"
@@ -221,8 +226,7 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     let one = block_means(&scene(1), "sppm", 16);
     let four = block_means(&scene(4), "sppm", 16);
     assert_agree(&one, &four, "SPPM one vs four wavelength groups");
-    let var = |b: &[Vec<f64>]| b.iter().map(|x| stats::mean_var(x).1).sum::<f64>();
-    let ratio = var(&four) / var(&one);
+    let ratio = variance_ratio(&four, &one);
     assert!(
         ratio < 1.6,
         "four groups' block variance {ratio:.2}× one group's"
