@@ -32,7 +32,7 @@ AttributeBegin
   AreaLightSource "diffuse" "rgb L" [8 8 8]
   Translate 0 1.99 0
   Shape "trianglemesh" "point3 P" [-0.3 0 -0.3  0.3 0 -0.3  0.3 0 0.3  -0.3 0 0.3]
-    "integer indices" [0 2 1 0 3 2]
+    "integer indices" [0 1 2 0 2 3]
 AttributeEnd
 Material "diffuse" "rgb reflectance" [0.6 0.5 0.4]
 Shape "trianglemesh" "point3 P" [-1 0 -1  1 0 -1  1 0 1  -1 0 1  -1 2 -1  1 2 -1  1 2 1  -1 2 1]
@@ -46,7 +46,7 @@ AttributeEnd
     )
 }
 
-const INTEGRATORS: [(&str, &str); 6] = [
+const INTEGRATORS: [(&str, &str); 7] = [
     ("path", r#""path" "integer maxdepth" [5]"#),
     ("lightpath", r#""lightpath" "integer maxdepth" [5]"#),
     ("bdpt", r#""bdpt" "integer maxdepth" [5]"#),
@@ -62,6 +62,9 @@ const INTEGRATORS: [(&str, &str); 6] = [
         "vcm",
         r#""vcm" "float radius" [0.1] "integer maxdepth" [5]"#,
     ),
+    // The default radius comes from a pilot light pass that every process
+    // must repeat identically.
+    ("vcm-default-radius", r#""vcm" "integer maxdepth" [5]"#),
 ];
 
 fn run(scene: &Path, args: &[&str], out: &Path) -> Output {

@@ -235,6 +235,7 @@ pub fn finish(
         }
         Settings::Vcm(mut settings) => {
             settings.radius = radius(warnings);
+            settings.radius_from_density = plan.radius.is_none();
             Box::new(VcmIntegrator::new(settings))
         }
         Settings::PhotonMap(settings) => {
@@ -451,6 +452,7 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
     Ok(VcmSettings {
         max_depth: c.max_depth,
         radius: 1.0,
+        radius_from_density: false,
         alpha: ck.float("alpha", 0.75, Domain::LeftOpen(0.0, 1.0))?,
         light_paths: photons_per_iteration(ck)?,
         seed: photon_seed(ck, c)?,

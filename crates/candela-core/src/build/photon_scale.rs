@@ -56,7 +56,9 @@ pub const FOOTPRINT_PIXELS: f32 = 3.0;
 /// and at one light path per pixel a merge's density π r² N_light p outweighs
 /// a connection's on diffuse paths well below SPPM's radius, so on diffuse
 /// light the radius sets the kernel bias of most of the image rather than
-/// the noise of its caustics (module docs of `integrator::vcm`).
+/// the noise of its caustics (module docs of `integrator::vcm`). It is the
+/// unit of VCM's radius warnings and the starting point of its pilot, which
+/// replaces it by the light vertices' density radius (`integrator::vcm::pilot`).
 pub const VCM_FOOTPRINT_PIXELS: f32 = 1.0;
 
 /// Default radius as a share of the bounding box's diagonal, for scenes the

@@ -70,17 +70,19 @@
 //! instructions. So `one` is the default; shadow rays are cheap in these
 //! small scenes, and the saving grows with the cost of a ray.
 //!
-//! **Default radius**: one pixel footprint at the median first-hit distance
-//! ([`crate::build::VCM_FOOTPRINT_PIXELS`]; SPPM and PPM start from three).
-//! At one light path per pixel a merge's density π r² N_light p exceeds a
-//! connection's on diffuse paths already at small r, so merges take most
-//! of the weight of plain diffuse light and r sets its kernel bias. At
-//! equal time (16 s, 2 threads, half resolution, relMSE against long
-//! references), 1 / 1.5 / 3 footprints gave 0.00135 / 0.0017 / 0.0036 on
-//! the Cornell box (path 0.00092, bdpt 0.00145) and 0.056 / (2: 0.036) /
-//! 0.025 on caustic-glass (sppm 0.052, bdpt 0.057): one footprint bounds the
-//! worst ratio to the best other integrator; caustic-heavy scenes gain from
-//! writing a larger `radius`.
+//! **Default radius**: without a written `radius`, the first pass runs a
+//! pilot light pass and takes the radius whose disk holds two other light
+//! vertices around the median one, within ½–6 pixel footprints
+//! ([`pilot`]). A merge's noise is set by the vertices in its disk and its
+//! kernel bias by the radius, and the vertex density per pixel footprint
+//! differs twentyfold between these scenes: the pilot chooses 0.85
+//! footprints on the Cornell box, 4.5 on caustic-glass and 3.3 on the pool
+//! (half resolution), near the best radius of each measured at equal time
+//! (16 s, 2 threads, relMSE against long references, two seeds):
+//! Cornell 0.00102–0.00114 (1 footprint, the old default: 0.00113–0.00126;
+//! 3: 0.0034–0.0036), caustic-glass 0.018–0.022 (1: 0.044–0.069; sppm
+//! 0.026–0.033 in the same run), pool 0.021 without its worst 0.1 % of
+//! pixels (1: 0.033–0.039).
 //!
 //! **α.** The default 0.75 is the paper's (Georgiev et al. 2012, §7 and
 //! SmallVCM's default): VCM's merges only carry the paths connections
@@ -93,6 +95,7 @@ mod merge;
 pub mod mis;
 #[cfg(test)]
 mod mis_brute;
+pub mod pilot;
 mod resample;
 
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
@@ -106,6 +109,7 @@ use camera::CameraPass;
 use light::LightVertex;
 use mis::Factors;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
 
 /// Memory of one stored light vertex in bytes (position, normals, BSDF,
 /// β, MIS quantities: [`LightVertex`]); an iteration stores
@@ -212,6 +216,9 @@ pub struct VcmSettings {
     pub max_depth: u32,
     /// Merge radius of the first iteration (`radius`; scene-scale default).
     pub radius: f32,
+    /// `radius` was not written: it is one pixel footprint, and the first
+    /// pass replaces it by the light vertices' density ([`pilot`]).
+    pub radius_from_density: bool,
     /// Radius reduction α (`alpha`, 0.75).
     pub alpha: f32,
     /// Light paths per iteration (`photonsperiteration`; ≤ 0: one per pixel
@@ -232,6 +239,7 @@ impl Default for VcmSettings {
         Self {
             max_depth: 5,
             radius: 1.0,
+            radius_from_density: false,
             alpha: 0.75,
             light_paths: -1,
             seed: 0,
@@ -252,6 +260,9 @@ pub struct VcmIntegrator {
     stored: AtomicU64,
     /// Storage reused from one iteration to the next.
     pools: Pools,
+    /// The first iteration's radius once known (the written one, or the
+    /// pilot's).
+    radius0: OnceLock<f32>,
 }
 
 /// The buffers a pass hands to the next ([`light::Pool`]).
@@ -270,7 +281,22 @@ impl VcmIntegrator {
             techniques,
             stored: AtomicU64::new(0),
             pools: Pools::default(),
+            radius0: OnceLock::new(),
         }
+    }
+
+    /// The first iteration's radius: the written one, or the light vertices'
+    /// density radius of a pilot pass ([`pilot`]); `None` if cancelled.
+    fn radius0(&self, ctx: &RenderContext<'_>) -> Option<f32> {
+        if let Some(&r) = self.radius0.get() {
+            return Some(r);
+        }
+        let r = if self.settings.radius_from_density && self.techniques.merge {
+            pilot::density_radius(self, ctx, self.settings.radius)?
+        } else {
+            self.settings.radius
+        };
+        Some(*self.radius0.get_or_init(|| r))
     }
 
     /// Light subpaths per iteration.
@@ -282,9 +308,10 @@ impl VcmIntegrator {
         }
     }
 
-    /// The merge radius of (0-based) pass `pass`.
+    /// The merge radius of (0-based) pass `pass` (before the first pass of
+    /// a density-derived radius: from the footprint default).
     pub fn radius(&self, pass: u64) -> f32 {
-        let r0 = self.settings.radius as f64;
+        let r0 = *self.radius0.get().unwrap_or(&self.settings.radius) as f64;
         (r0 * r0 * ppm_radius2(pass + 1, self.settings.alpha as f64)).sqrt() as f32
     }
 
@@ -341,6 +368,9 @@ impl Integrator for VcmIntegrator {
         block: &mut PassBlock,
     ) -> PassOutcome {
         let t = self.techniques;
+        if self.radius0(ctx).is_none() {
+            return PassOutcome::Cancelled;
+        }
         let radius = self.radius(pass);
         let n_light = self.light_paths(ctx) as f32;
         let f = Factors::new(radius, n_light, t.connect, t.merge);
