@@ -417,11 +417,18 @@ impl Integrator for VcmIntegrator {
     }
 
     fn status(&self, _state: &IntegratorState, next_pass: u64) -> Option<String> {
-        let mut s = format!(
-            "iteration {}, radius {:.4}",
-            next_pass + 1,
-            self.radius(next_pass)
-        );
+        let pending = self.settings.radius_from_density
+            && self.techniques.merge
+            && self.radius0.get().is_none();
+        let mut s = if pending {
+            format!("iteration {}, radius from a pilot pass", next_pass + 1)
+        } else {
+            format!(
+                "iteration {}, radius {:.4}",
+                next_pass + 1,
+                self.radius(next_pass)
+            )
+        };
         let stored = self.stored.load(Ordering::Relaxed);
         if stored > 0 {
             let merge = if self.techniques.merge {

@@ -33,6 +33,7 @@ use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::RenderContext;
 use crate::math::Vec3;
 use crate::spatial::HashGrid;
+use std::sync::atomic::AtomicU64;
 
 /// Other light vertices the default radius's disk holds around the median
 /// stored vertex (module docs).
@@ -70,7 +71,13 @@ pub(super) fn density_radius(
     let f = Factors::new(footprint, n_light, false, true);
     let lambda = *pass_wavelengths(vcm.settings.seed, PILOT_PASS, 1).group(0);
     let time = vcm.time(ctx, PILOT_PASS);
-    let light = vcm.light_pass(ctx, PILOT_PASS, &lambda, time, &f)?;
+    // Its own work counter: the pass's progress counts rendered paths only.
+    let work = AtomicU64::new(0);
+    let pilot = RenderContext {
+        work: &work,
+        ..*ctx
+    };
+    let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f)?;
     let points: Vec<Vec3> = light
         .chunks()
         .iter()
