@@ -26,6 +26,14 @@
 //! footprints so that a pilot that finds almost nothing, or a caustic that
 //! holds almost every vertex, cannot choose an absurd kernel; with no
 //! vertex at all the footprint default stays.
+//!
+//! Checked beyond the three scenes it was fitted on (relMSE against long
+//! path-traced references): env-metals (an environment light; the pilot
+//! takes the upper bound, 6 footprints; 8 s, one seed) 0.00022 against
+//! 0.00024 at one footprint; killeroo-simple at 176² (4.7 footprints; 16 s,
+//! two seeds) 0.0015–0.0018 against 0.0014–0.0017, 8 % worse: its light
+//! vertices spread over a floor far larger than the view, and the median
+//! vertex, not the median visible point, sets the radius.
 
 use super::mis::Factors;
 use super::VcmIntegrator;
