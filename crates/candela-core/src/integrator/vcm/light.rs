@@ -253,9 +253,15 @@ pub fn light_densities(scene: &Scene, id: LightId, it: &Interaction, w: Vec3) ->
     (pmf * direct, pmf * pos * dir, cos)
 }
 
+/// What one parallel lane of a light pass returns: its splat buffer (when
+/// it splats) and its chunks with their indices.
+type Lane = (Option<SplatBuffer>, Vec<(u64, PathChunk)>);
+
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
-    /// `lambda` and time `time`; `None` if the render was cancelled.
+    /// `lambda` and time `time`, splatting their camera connections when
+    /// `splat` (the pilot pass wants only the vertices); `None` if the
+    /// render was cancelled.
     pub(super) fn light_pass(
         &self,
         ctx: &RenderContext<'_>,
@@ -263,14 +269,15 @@ impl VcmIntegrator {
         lambda: &SampledWavelengths,
         time: f32,
         f: &Factors,
+        splat: bool,
     ) -> Option<LightPaths> {
         let n = self.light_paths(ctx);
         let chunk = CHUNK as u64;
         let n_chunks = n.div_ceil(chunk);
-        let lanes: Vec<(SplatBuffer, Vec<(u64, PathChunk)>)> = (0..LANES as u64)
+        let lanes: Vec<Lane> = (0..LANES as u64)
             .into_par_iter()
             .map(|lane| {
-                let mut buf = self.pools.splats.splats(ctx);
+                let mut buf = splat.then(|| self.pools.splats.splats(ctx));
                 let mut chunks = Vec::new();
                 for c in (lane..n_chunks).step_by(LANES) {
                     if ctx.cancelled() {
@@ -287,7 +294,7 @@ impl VcmIntegrator {
                             time,
                             f,
                             &mut out.vertices,
-                            &mut buf,
+                            buf.as_mut(),
                         );
                         out.ends.push(out.vertices.len() as u32);
                     }
@@ -303,7 +310,7 @@ impl VcmIntegrator {
         let mut splats = Vec::with_capacity(LANES);
         let mut chunks = Vec::new();
         for (buf, c) in lanes {
-            splats.push(buf);
+            splats.extend(buf);
             chunks.extend(c);
         }
         chunks.sort_by_key(|c| c.0);
@@ -314,7 +321,7 @@ impl VcmIntegrator {
     }
 
     /// Walks light path `i`, storing its vertices in `out` and splatting its
-    /// camera connections into `buf`.
+    /// camera connections into `buf` (none without one).
     #[allow(clippy::too_many_arguments)]
     fn trace_light(
         &self,
@@ -325,7 +332,7 @@ impl VcmIntegrator {
         time: f32,
         f: &Factors,
         out: &mut Vec<LightVertex>,
-        buf: &mut SplatBuffer,
+        mut buf: Option<&mut SplatBuffer>,
     ) {
         let scene = ctx.scene;
         let mut rng = StreamRng::with_hash(hash_u64s(&[self.settings.seed, pass, i, 0x5643_4d4c]));
@@ -342,7 +349,7 @@ impl VcmIntegrator {
             return;
         }
         let mis = Partial::light(direct, emission, cos, ty.is_delta(), f);
-        if self.techniques.light_only {
+        if let (true, Some(buf)) = (self.techniques.light_only, buf.as_deref_mut()) {
             self.splat_light_point(ctx, &ls.vertex, &ls, lambda, &mut rng, buf);
         }
         let w = Walk {
@@ -407,7 +414,8 @@ struct LightVisitor<'a, 'b> {
     prev: PrevVertex,
     pending: Option<Scatter>,
     out: &'a mut Vec<LightVertex>,
-    buf: &'a mut SplatBuffer,
+    /// Where camera connections are splatted (`None`: not made).
+    buf: Option<&'a mut SplatBuffer>,
 }
 
 impl Visitor<StreamRng> for LightVisitor<'_, '_> {
@@ -451,7 +459,7 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
                 terminated: lam.secondary_terminated(),
             });
         }
-        if t.connect || t.light_only {
+        if (t.connect || t.light_only) && self.buf.is_some() {
             self.connect_to_camera(v, rng);
         }
         Flow::Continue
@@ -504,6 +512,8 @@ impl LightVisitor<'_, '_> {
             return;
         }
         let scale = w * self.vcm.splat_scale(ctx);
-        self.buf.add(cs.p_raster, c * scale, self.lambda);
+        if let Some(buf) = self.buf.as_deref_mut() {
+            buf.add(cs.p_raster, c * scale, self.lambda);
+        }
     }
 }

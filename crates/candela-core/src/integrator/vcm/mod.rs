@@ -378,7 +378,7 @@ impl Integrator for VcmIntegrator {
         // shares its wavelengths, so merged power stays spectral.
         let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);
         let time = self.time(ctx, pass);
-        let Some(mut light) = self.light_pass(ctx, pass, &lambda, time, &f) else {
+        let Some(mut light) = self.light_pass(ctx, pass, &lambda, time, &f, true) else {
             return PassOutcome::Cancelled;
         };
         self.stored.store(light.len() as u64, Ordering::Relaxed);

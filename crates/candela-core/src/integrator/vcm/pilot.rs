@@ -85,12 +85,13 @@ pub(super) fn density_radius(
         work: &work,
         ..*ctx
     };
-    let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f)?;
+    let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f, false)?;
     let points: Vec<Vec3> = light
         .chunks()
         .iter()
         .flat_map(|c| c.iter().map(|v| v.p()))
         .collect();
+    light.recycle(&vcm.pools.chunks);
     Some(radius_for_neighbours(&points, footprint))
 }
 
