@@ -290,6 +290,12 @@ fn film_sampler_and_integrator_settings_must_be_in_their_domain() {
                 "\"integer maxdepth\"",
                 "Integrator \"path\" \"maxdepth\" must be at least 0, found -1",
             ),
+            opts(
+                "Integrator \"vcm\" \"string mode\" \"bpm\" \"string directmerges\" \"never\"",
+                "\"string directmerges\"",
+                "Integrator \"vcm\" \"directmerges\" \"never\" needs connections (mode \"vcm\"): \
+                 this mode has no other technique for direct light",
+            ),
         ],
     );
 }

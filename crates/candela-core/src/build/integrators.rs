@@ -14,10 +14,10 @@ use super::{BuildError, Overrides};
 use crate::integrator::photonmap::Kernel;
 use crate::integrator::wavelengths::{DEFAULT_GROUPS, MAX_GROUPS};
 use crate::integrator::{
-    BdptIntegrator, BdptSettings, Connections, Integrator, IntegratorKind, LightTracer,
-    LightTracerSettings, PathIntegrator, PathSettings, PhotonMapIntegrator, PhotonMapSettings,
-    PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator, VcmMode, VcmSettings,
-    Visualize,
+    BdptIntegrator, BdptSettings, Connections, DirectMerges, Integrator, IntegratorKind,
+    LightTracer, LightTracerSettings, PathIntegrator, PathSettings, PhotonMapIntegrator,
+    PhotonMapSettings, PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, VcmIntegrator,
+    VcmMode, VcmSettings, Visualize,
 };
 use crate::light::LightSelection;
 use candela_scene::{Entity, Loc, ParamSet, SceneDescription};
@@ -459,5 +459,28 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
         regularize: c.regularize,
         mode,
         connections,
+        direct_merges: vcm_direct_merges(ck, mode)?,
     })
+}
+
+/// `"string directmerges"`: which merges next to the light exist
+/// (`integrator::vcm::mis`); all of them in the modes whose only technique
+/// for direct light they are.
+fn vcm_direct_merges(ck: &Check<'_>, mode: VcmMode) -> Result<DirectMerges, BuildError> {
+    let connects = matches!(mode, VcmMode::Vcm | VcmMode::Bpt | VcmMode::Lt);
+    let default = if connects { "afterspecular" } else { "always" };
+    let name = ck.params.get_string("directmerges", default)?;
+    let Some(d) = DirectMerges::from_name(&name) else {
+        return Err(ck.error(
+            "directmerges",
+            format!("\"{name}\" is unknown (known: {})", DirectMerges::NAMES),
+        ));
+    };
+    if d != DirectMerges::Always && !connects {
+        return Err(ck.error(
+            "directmerges",
+            format!("\"{name}\" needs connections (mode \"vcm\"): this mode has no other technique for direct light"),
+        ));
+    }
+    Ok(d)
 }

@@ -40,6 +40,7 @@ pub use light_tracer::{LightTracer, LightTracerSettings};
 pub use path::{PathIntegrator, PathSettings};
 pub use photonmap::{PhotonMapIntegrator, PhotonMapSettings};
 pub use sppm::{PpmIntegrator, PpmSettings, SppmIntegrator, SppmSettings, SppmState};
+pub use vcm::mis::DirectMerges;
 pub use vcm::{Connections, VcmIntegrator, VcmMode, VcmSettings};
 
 use crate::camera::Camera;

@@ -21,7 +21,7 @@
 
 use super::light::{light_densities, LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
-use super::mis::{weight, Factors, Partial};
+use super::mis::{weight, Deferred, Factors, Partial};
 use super::resample::Resampler;
 use super::{Connections, VcmIntegrator};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
@@ -117,6 +117,9 @@ impl VcmIntegrator {
             mis: Partial::camera(pdf_pixel, n_light, ctx.camera.is_connectable()),
             prev: PrevVertex::of(&lens),
             pending: None,
+            arrived_delta: false,
+            last: Deferred::default(),
+            last_after_delta: false,
             specular: true,
             vertices: 0,
             l: SampledSpectrum::zero(),
@@ -150,6 +153,13 @@ struct CameraVisitor<'a, 'b> {
     mis: Partial,
     prev: PrevVertex,
     pending: Option<Scatter>,
+    /// The scattering that reached the current vertex was a delta (not
+    /// at the first vertex).
+    arrived_delta: bool,
+    /// The terms of a merge at the vertex left last, and whether that
+    /// vertex had been reached by a delta scattering.
+    last: Deferred,
+    last_after_delta: bool,
     /// Every scattering so far was a delta.
     specular: bool,
     /// Surface vertices visited.
@@ -178,13 +188,11 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
         lambda: &mut SampledWavelengths,
         rng: &mut Sampler,
     ) -> Flow {
-        if let Some(s) = self.pending.take() {
-            let cos_out = v.wo.dot(self.prev.n).abs();
-            self.mis
-                .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
-        }
+        self.apply_scatter(v.wo.dot(self.prev.n).abs());
         let d2 = (v.p() - self.prev.p).length_squared();
-        self.mis.hit(d2, v.wo.dot(v.it.n).abs());
+        let cos_in = v.wo.dot(v.it.n).abs();
+        self.mis.hit(d2, cos_in);
+        self.last.hit(cos_in);
         self.prev = PrevVertex::of(v);
         self.vertices += 1;
         self.emission(v, lambda);
@@ -216,11 +224,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
     }
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
-        if let Some(s) = self.pending.take() {
-            let cos_out = e.ray.d.normalize().dot(self.prev.n).abs();
-            self.mis
-                .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, &self.cp.f);
-        }
+        self.apply_scatter(e.ray.d.normalize().dot(self.prev.n).abs());
         let scene = self.ctx.scene;
         for &id in scene.infinite_lights() {
             let le = scene.light(id).le(&e.ray, lambda);
@@ -242,12 +246,35 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
 }
 
 impl CameraVisitor<'_, '_> {
-    /// The weight of emission found by the camera subpath [eq. 43].
+    /// Applies the pending scattering, leaving the previous vertex with
+    /// geometric cosine `cos_out`, to the partials [eqs. 34–36], keeping
+    /// the terms of a merge at the vertex left (module doc of [`super::mis`]).
+    fn apply_scatter(&mut self, cos_out: f32) {
+        let Some(s) = self.pending.take() else { return };
+        let f = &self.cp.f;
+        self.last = self
+            .mis
+            .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, f, true);
+        self.last_after_delta = self.arrived_delta;
+        self.arrived_delta = s.delta;
+    }
+
+    /// The weight of emission found by the camera subpath [eq. 43]: the
+    /// vertex it left last is next to the light, and a merge there counts
+    /// only where it exists.
     fn emission_weight(&self, direct: f32, emission: f32) -> f32 {
         if !self.vcm.techniques.connect {
             return if self.specular { 1.0 } else { 0.0 };
         }
-        weight(0.0, self.mis.emission_weight(direct, emission))
+        let mis = if self.cp.f.merges_at(true, self.last_after_delta) {
+            self.mis
+        } else {
+            Partial {
+                d_vc: self.last.d_vc_without,
+                ..self.mis
+            }
+        };
+        weight(0.0, mis.emission_weight(direct, emission))
     }
 
     /// s = 0 at a surface vertex that emits.
@@ -305,7 +332,9 @@ impl CameraVisitor<'_, '_> {
         };
         let w_light = super::mis::mis(bsdf_dir * cos_light * inv_d2 / direct);
         let ratio = emission * cos_recv * inv_d2 / direct;
-        let w_cam = self.mis.connect_weight(ratio, bsdf_rev, &self.cp.f);
+        // A merge at v, next to the light, exists after a specular vertex.
+        let merge = self.cp.f.merges_at(true, self.arrived_delta);
+        let w_cam = self.mis.connect_weight(ratio, bsdf_rev, &self.cp.f, merge);
         self.l += v.beta * ls.unweighted() * weight(w_light, w_cam);
     }
 
@@ -371,8 +400,11 @@ impl CameraVisitor<'_, '_> {
         let cam_dir_a = cam_dir.0 * w.dot(lv.it.n).abs() / d2;
         let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
         let f = &self.cp.f;
-        let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f);
-        let w_cam = self.mis.connect_weight(light_dir_a, cam_rev.0, f);
+        // Merges at either end: not next to the light at the camera's; at a
+        // light vertex x_1 its camera-side neighbour is v, not specular.
+        let merge_light = f.merges_at(lv.depth == 1, false);
+        let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f, merge_light);
+        let w_cam = self.mis.connect_weight(light_dir_a, cam_rev.0, f, true);
         let mw = weight(w_light, w_cam);
         (mw != 0.0).then(|| unfold(c * mw, terminated, lv.terminated))
     }
@@ -382,6 +414,7 @@ impl CameraVisitor<'_, '_> {
         let Some(grid) = self.cp.grid else { return };
         let max_depth = self.vcm.settings.max_depth;
         let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
+        let after_delta = self.arrived_delta;
         let r2 = self.cp.radius * self.cp.radius;
         let x = Surfel {
             p: v.p(),
@@ -390,7 +423,7 @@ impl CameraVisitor<'_, '_> {
         };
         let mut sum = SampledSpectrum::zero();
         grid.for_each_within(v.p(), self.cp.radius, |ph| {
-            if ph.depth + v.depth > max_depth + 1 {
+            if ph.depth + v.depth > max_depth + 1 || !f.merges_at(ph.depth == 1, after_delta) {
                 return;
             }
             let Some(c) = gather(&x, &ph.surfel, r2) else {

@@ -16,7 +16,7 @@
 //! array, into freshly faulted pages, was a serial memcpy of ~12 MB per
 //! iteration at 128².
 
-use super::mis::{weight, Factors, Partial};
+use super::mis::{weight, Deferred, Factors, Partial};
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
 use crate::film::SplatBuffer;
@@ -105,6 +105,8 @@ pub(super) struct PrevVertex {
     pub n: Vec3,
     /// A light endpoint at infinity.
     pub at_infinity: bool,
+    /// Surface vertices of its subpath up to it (0 at the light or lens).
+    pub depth: u32,
 }
 
 impl PrevVertex {
@@ -114,6 +116,7 @@ impl PrevVertex {
             p: v.p(),
             n: v.it.n,
             at_infinity: v.at_infinity(),
+            depth: v.depth,
         }
     }
 }
@@ -367,6 +370,7 @@ impl VcmIntegrator {
             mis,
             prev: PrevVertex::of(&ls.vertex),
             pending: None,
+            first: None,
             out,
             buf,
         };
@@ -413,6 +417,9 @@ struct LightVisitor<'a, 'b> {
     mis: Partial,
     prev: PrevVertex,
     pending: Option<Scatter>,
+    /// The terms of a merge at x_1, until x_2 scatters (module doc of
+    /// [`super::mis`]).
+    first: Option<Deferred>,
     out: &'a mut Vec<LightVertex>,
     /// Where camera connections are splatted (`None`: not made).
     buf: Option<&'a mut SplatBuffer>,
@@ -429,16 +436,38 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
         rng: &mut StreamRng,
     ) -> Flow {
         if let Some(s) = self.pending.take() {
+            // x_2 scattered: the merge at x_1 exists if it did so specularly.
+            if let Some(first) = self.first.take() {
+                if s.delta {
+                    self.mis.add(&first);
+                }
+            }
             let cos_out = v.wo.dot(self.prev.n).abs();
-            self.mis
-                .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, self.f);
+            let next_to_light = self.prev.depth == 1;
+            // Leaving x_1, whether its merge exists waits for x_2 (module
+            // doc of `mis`).
+            let merge_here = self.f.merges_at(next_to_light, false);
+            let merge = self.mis.scatter(
+                s.delta,
+                s.pdf_fwd.0,
+                s.pdf_rev.0,
+                cos_out,
+                self.f,
+                merge_here,
+            );
+            let deferred = next_to_light && !merge_here && self.f.merges_at(true, true);
+            self.first = deferred.then_some(merge);
         }
         let d2 = if self.prev.at_infinity {
             1.0
         } else {
             (v.p() - self.prev.p).length_squared()
         };
-        self.mis.hit(d2, v.wo.dot(v.it.n).abs());
+        let cos_in = v.wo.dot(v.it.n).abs();
+        self.mis.hit(d2, cos_in);
+        if let Some(first) = &mut self.first {
+            first.hit(cos_in);
+        }
         self.prev = PrevVertex::of(v);
         let Some(bsdf) = &v.bsdf else {
             return Flow::Continue;
@@ -506,7 +535,13 @@ impl LightVisitor<'_, '_> {
                 )
                 .0
             });
-            weight(self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f), 0.0)
+            // A merge here exists unless next to the light: the lens is
+            // the camera-side neighbour.
+            let merge = self.f.merges_at(v.depth == 1, false);
+            weight(
+                self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f, merge),
+                0.0,
+            )
         };
         if w == 0.0 || !ctx.scene.unoccluded(&v.it, &cs.p_lens) {
             return;

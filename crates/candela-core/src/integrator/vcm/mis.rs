@@ -17,12 +17,65 @@
 //! both subpaths, so every technique is weighed with the same densities.
 //! Russian roulette is left out of the densities: weights built from the
 //! same density functions on every technique still sum to one.
+//!
+//! **Merges next to the light** (`"string directmerges"`). A merge at the
+//! vertex x_1 that the light reaches directly estimates direct light by
+//! density, which next-event estimation, light tracing and hitting the
+//! light sample without a kernel; on a diffuse scene those merges add the
+//! kernel's bias (across a crease it averages the lit and the unlit face)
+//! and, from the few light vertices in a disk of pixel size, more noise
+//! than they take away. SPPM leaves them out the same way: its photons are
+//! stored from their second vertex and direct light comes by light
+//! sampling [Hachisuka & Jensen 2009, §4; pbrt-v4 `SPPMIntegrator`]. But
+//! when the camera sees x_1 only through a specular vertex x_2 (a floor
+//! behind glass), the merge is what smooths it: next-event estimation sees
+//! the glass's shadow sharp where the light's photons arrive. So by
+//! default (`afterspecular`) the merge at x_1 is a technique of a path
+//! exactly when x_2 is specular; `always` keeps every such merge (the modes
+//! without connections, `bpm` and `ppm`, whose only technique for direct
+//! light they are), `never` none. Whether a path has the technique is a
+//! function of the path, so the weights of every other technique must
+//! count it exactly then: its term enters the light subpath's recursion at
+//! x_1 only once x_2 is known to scatter specularly ([`Deferred`]); a
+//! connection's weight at a vertex next to the light counts it when that
+//! vertex's camera-side neighbour is specular ([`Partial::connect_weight`]:
+//! next-event estimation's camera vertex reached by a delta scattering;
+//! never a light vertex x_1, whose neighbour is a connection's end); and
+//! the camera subpath hitting the light counts it when the vertex it last
+//! left was itself reached by a delta scattering (its d_VC without that
+//! term is [`Deferred::d_vc_without`]).
 
 /// The heuristic's power applied to a density or density ratio (β = 2)
 /// [Veach 1997, eq. 9.13].
 #[inline]
 pub fn mis(x: f32) -> f32 {
     x * x
+}
+
+/// Which merges at a vertex next to the light are a technique (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectMerges {
+    /// Every one.
+    Always,
+    /// Where the path's next vertex towards the camera is specular.
+    AfterSpecular,
+    /// None.
+    Never,
+}
+
+impl DirectMerges {
+    /// The setting named `s`, if any.
+    pub fn from_name(s: &str) -> Option<Self> {
+        match s {
+            "always" => Some(DirectMerges::Always),
+            "afterspecular" => Some(DirectMerges::AfterSpecular),
+            "never" => Some(DirectMerges::Never),
+            _ => None,
+        }
+    }
+
+    /// Names accepted by [`DirectMerges::from_name`].
+    pub const NAMES: &'static str = "always, afterspecular, never";
 }
 
 /// The per-iteration constants of eq. 20 and the merge normalisation.
@@ -34,17 +87,34 @@ pub struct Factors {
     pub vc: f32,
     /// 1/η_VCM = 1/(π r² N_light), the merge kernel's normalisation.
     pub merge_norm: f32,
+    /// Which merges next to the light exist (module doc).
+    pub direct: DirectMerges,
 }
 
 impl Factors {
-    /// The constants for radius `r` and `n_light` light paths.
-    pub fn new(r: f32, n_light: f32, connect: bool, merge: bool) -> Self {
+    /// The constants for radius `r`, `n_light` light paths and the merges
+    /// next to the light `direct`.
+    pub fn new(r: f32, n_light: f32, connect: bool, merge: bool, direct: DirectMerges) -> Self {
         let eta = std::f32::consts::PI * r * r * n_light;
         Self {
             vm: if merge { mis(eta) } else { 0.0 },
             vc: if connect { mis(1.0 / eta) } else { 0.0 },
             merge_norm: 1.0 / eta,
+            direct,
         }
+    }
+
+    /// Whether a merge at a vertex is a technique (merging on): always
+    /// unless the vertex is next to the light; there, by `direct` and
+    /// whether its camera-side neighbour is specular (`after_delta`).
+    #[inline]
+    pub fn merges_at(&self, next_to_light: bool, after_delta: bool) -> bool {
+        !next_to_light
+            || match self.direct {
+                DirectMerges::Always => true,
+                DirectMerges::AfterSpecular => after_delta,
+                DirectMerges::Never => false,
+            }
     }
 }
 
@@ -57,6 +127,33 @@ pub struct Partial {
     pub d_vc: f32,
     /// Merges only.
     pub d_vm: f32,
+}
+
+/// The terms of a merge at the vertex a scattering left, for a caller that
+/// learns only later whether that merge exists (module doc), and d_VC
+/// without them; carried along by [`Deferred::hit`] as the partials are.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Deferred {
+    /// The merge's term of d_VC.
+    pub vc: f32,
+    /// The merge's term of d_VM.
+    pub vm: f32,
+    /// d_VC without the merge's term.
+    pub d_vc_without: f32,
+}
+
+impl Deferred {
+    /// The arrival at the next vertex ([`Partial::hit`]).
+    pub fn hit(&mut self, cos: f32) {
+        let c = mis(cos);
+        if c == 0.0 {
+            *self = Self::default();
+            return;
+        }
+        self.vc /= c;
+        self.vm /= c;
+        self.d_vc_without /= c;
+    }
 }
 
 impl Partial {
@@ -107,34 +204,62 @@ impl Partial {
     /// A scattering with forward density `pdf_fwd`, reverse density
     /// `pdf_rev` and geometric outgoing cosine `cos_out` [eqs. 34–36]; a
     /// delta lobe keeps the chain (its two densities are equal and cancel).
-    pub fn scatter(&mut self, delta: bool, pdf_fwd: f32, pdf_rev: f32, cos_out: f32, f: &Factors) {
+    /// The term of a merge at the vertex left is added when `merge_here`,
+    /// and returned either way (module doc).
+    pub fn scatter(
+        &mut self,
+        delta: bool,
+        pdf_fwd: f32,
+        pdf_rev: f32,
+        cos_out: f32,
+        f: &Factors,
+        merge_here: bool,
+    ) -> Deferred {
         if delta {
             self.d_vcm = 0.0;
             self.d_vc *= mis(cos_out);
             self.d_vm *= mis(cos_out);
-            return;
+            return Deferred {
+                d_vc_without: self.d_vc,
+                ..Deferred::default()
+            };
         }
         if pdf_fwd <= 0.0 {
             *self = Self::default();
-            return;
+            return Deferred::default();
         }
         let g = mis(cos_out / pdf_fwd);
         let rev = mis(pdf_rev);
-        let d_vc = g * (self.d_vc * rev + self.d_vcm + f.vm);
-        let d_vm = g * (self.d_vm * rev + self.d_vcm * f.vc + 1.0);
+        let merge = Deferred {
+            vc: g * f.vm,
+            vm: g,
+            d_vc_without: g * (self.d_vc * rev + self.d_vcm),
+        };
         *self = Self {
             d_vcm: mis(1.0 / pdf_fwd),
-            d_vc,
-            d_vm,
+            d_vc: merge.d_vc_without,
+            d_vm: g * (self.d_vm * rev + self.d_vcm * f.vc),
         };
+        if merge_here {
+            self.add(&merge);
+        }
+        merge
+    }
+
+    /// Adds the terms of a merge found to exist after the scattering.
+    pub fn add(&mut self, merge: &Deferred) {
+        self.d_vc += merge.vc;
+        self.d_vm += merge.vm;
     }
 
     /// The partial weight of this subpath when the other side's join
     /// generated its last vertex with area density `pdf_join_a` and this
     /// vertex's BSDF would have continued back with `pdf_rev` [eqs. 40, 41,
-    /// 45; for a light-tracing join eq. 46].
-    pub fn connect_weight(&self, pdf_join_a: f32, pdf_rev: f32, f: &Factors) -> f32 {
-        mis(pdf_join_a) * (f.vm + self.d_vcm + self.d_vc * mis(pdf_rev))
+    /// 45; for a light-tracing join eq. 46]. A merge at this vertex counts
+    /// where it exists ([`Factors::merges_at`]).
+    pub fn connect_weight(&self, pdf_join_a: f32, pdf_rev: f32, f: &Factors, merge: bool) -> f32 {
+        let vm = if merge { f.vm } else { 0.0 };
+        mis(pdf_join_a) * (vm + self.d_vcm + self.d_vc * mis(pdf_rev))
     }
 
     /// The partial weight of this subpath in a merge whose other side would
@@ -179,7 +304,7 @@ mod tests {
         let (d2, cos_x_light, cos_x_cam) = (2.0f32, 0.6f32, 0.9f32);
         let (e2, pdf_pixel, n_light) = (3.0f32, 5.0f32, 16.0f32);
         let bsdf_pdf_to_light = 0.4f32; // x's BSDF density towards y.
-        let f = Factors::new(0.1, n_light, true, false);
+        let f = Factors::new(0.1, n_light, true, false, DirectMerges::Always);
         // Area densities of x from each side and of y from x.
         let x_from_light = p_dir_light * cos_x_light / d2;
         let x_from_cam = pdf_pixel * cos_x_cam / e2 / n_light; // per light path
@@ -202,12 +327,17 @@ mod tests {
         let mut light = Partial::light(p_y, emission, cos_y, false, &f);
         light.hit(d2, cos_x_light);
         let lt = weight(
-            light.connect_weight(pdf_pixel * cos_x_cam / e2 / n_light, bsdf_pdf_to_light, &f),
+            light.connect_weight(
+                pdf_pixel * cos_x_cam / e2 / n_light,
+                bsdf_pdf_to_light,
+                &f,
+                true,
+            ),
             0.0,
         );
         // Hitting y from x: camera scattered at x towards y.
         let mut cam_y = cam;
-        cam_y.scatter(false, bsdf_pdf_to_light, 0.0, cos_x_light, &f);
+        cam_y.scatter(false, bsdf_pdf_to_light, 0.0, cos_x_light, &f, true);
         cam_y.hit(d2, cos_y);
         let hit = weight(0.0, cam_y.emission_weight(p_y, emission));
         let got = [hit, nee, lt];

@@ -70,19 +70,35 @@
 //! instructions. So `one` is the default; shadow rays are cheap in these
 //! small scenes, and the saving grows with the cost of a ray.
 //!
+//! **Merges next to the light** (`"string directmerges"`, [`mis`]): by
+//! default (`afterspecular`) a light vertex that the light reached
+//! directly merges only with camera vertices reached through a specular
+//! one (a floor seen through glass); elsewhere direct light is left to
+//! next-event estimation, light tracing and hitting the light, as SPPM
+//! does, and the MIS weights leave that merge out exactly where it does
+//! not exist. `always` merges them everywhere (the modes without
+//! connections must), `never` nowhere. Measured at equal time (16 s, 2
+//! threads, half resolution, relMSE against long references, seed 1),
+//! with the default radius of each: the Cornell box 0.000607 against
+//! `always`'s 0.000714, with no bright seam where a lit box top meets its
+//! dimmer side (the merge kernel averaged the two faces' direct light
+//! there, +0.15 on the seam's pixels at radius 0.064); the pool 0.0145
+//! against 0.0159; caustic-glass 0.0135 against 0.0119, where `never` gave
+//! 0.0248 (the floor seen through the glass, in and out of its shadow).
+//!
 //! **Default radius**: without a written `radius`, the first pass runs a
-//! pilot light pass and takes the radius whose disk holds two other light
-//! vertices around the median one, within ½–6 pixel footprints
-//! ([`pilot`]). A merge's noise is set by the vertices in its disk and its
-//! kernel bias by the radius, and the vertex density per pixel footprint
-//! differs twentyfold between these scenes: the pilot chooses 0.85
-//! footprints on the Cornell box, 4.5 on caustic-glass and 3.3 on the pool
-//! (half resolution), near the best radius of each measured at equal time
-//! (16 s, 2 threads, relMSE against long references, two seeds):
-//! Cornell 0.00102–0.00114 (1 footprint, the old default: 0.00113–0.00126;
-//! 3: 0.0034–0.0036), caustic-glass 0.018–0.022 (1: 0.044–0.069; sppm
-//! 0.026–0.033 in the same run), pool 0.021 without its worst 0.1 % of
-//! pixels (1: 0.033–0.039).
+//! pilot light pass and takes the radius whose disk holds three other
+//! merging light vertices around the median one, within ½–6 pixel
+//! footprints ([`pilot`]). A merge's noise is set by the vertices in its
+//! disk and its kernel bias by the radius, and the vertex density per
+//! pixel footprint differs twentyfold between these scenes. Measured as
+//! above (16 s, two seeds where given) with the neighbour count K: the
+//! Cornell box 0.000607 (K = 2), 0.000557–0.000582 (3), 0.000530–0.000597
+//! (4), 0.000491 (8); the pool 0.0145 (2), 0.0148–0.0178 (3), 0.0197–0.0212
+//! (4), 0.0335 (8); caustic-glass 0.0127–0.0135 at every K (its radius is
+//! the 6-footprint bound). Diffuse interreflection wants many neighbours,
+//! caustics few; K = 3 keeps both within the equal-time targets of the
+//! benchmark (`bench/vcm_equal_time.py`).
 //!
 //! **α.** The default 0.75 is the paper's (Georgiev et al. 2012, §7 and
 //! SmallVCM's default): VCM's merges only carry the paths connections
@@ -107,7 +123,7 @@ use crate::sampling::hash_u64s;
 use crate::sampling::PdfSolidAngle;
 use camera::CameraPass;
 use light::LightVertex;
-use mis::Factors;
+use mis::{DirectMerges, Factors};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::OnceLock;
 
@@ -232,6 +248,9 @@ pub struct VcmSettings {
     pub mode: VcmMode,
     /// Connections per camera vertex (`connections`).
     pub connections: Connections,
+    /// Merges at the vertex next to the light (`directmerges`; module doc
+    /// of [`mis`]).
+    pub direct_merges: DirectMerges,
 }
 
 impl Default for VcmSettings {
@@ -246,6 +265,7 @@ impl Default for VcmSettings {
             regularize: false,
             mode: VcmMode::Vcm,
             connections: Connections::One,
+            direct_merges: DirectMerges::AfterSpecular,
         }
     }
 }
@@ -297,6 +317,17 @@ impl VcmIntegrator {
             self.settings.radius
         };
         Some(*self.radius0.get_or_init(|| r))
+    }
+
+    /// Which merges at a vertex next to the light are a technique: the
+    /// `directmerges` setting, every one in the modes without connections
+    /// ([`mis`]).
+    fn direct_merges(&self) -> DirectMerges {
+        if self.techniques.connect {
+            self.settings.direct_merges
+        } else {
+            DirectMerges::Always
+        }
     }
 
     /// Light subpaths per iteration.
@@ -373,7 +404,7 @@ impl Integrator for VcmIntegrator {
         }
         let radius = self.radius(pass);
         let n_light = self.light_paths(ctx) as f32;
-        let f = Factors::new(radius, n_light, t.connect, t.merge);
+        let f = Factors::new(radius, n_light, t.connect, t.merge, self.direct_merges());
         // One wavelength group: every light and camera path of the iteration
         // shares its wavelengths, so merged power stays spectral.
         let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);

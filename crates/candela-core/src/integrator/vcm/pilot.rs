@@ -3,19 +3,20 @@
 //! A merge's variance is set by how many light vertices fall in its disk
 //! and its kernel bias by the disk's radius, so no radius in pixel units
 //! suits every scene: on the Cornell box one iteration stores ~2.6 light
-//! vertices per pixel footprint², and a radius of one footprint already
-//! gives merges most of the weight of diffuse light with a visible kernel
-//! bias; on caustic-glass (0.3 per footprint²) or the pool (0.14, on the
-//! floor under the water) merges at one footprint find a vertex or two and
-//! their noise dominates. Measured at equal time (16 s, half resolution,
-//! relMSE against long references): the Cornell box is best at 0.7–1
-//! footprint (0.0011–0.0012; 0.0035 at 3), caustic-glass at 3–5
-//! (0.021–0.028; 0.044–0.069 at 1), the pool at 3 (0.032; 0.043 at 1, 0.065
-//! at 6).
+//! vertices per pixel footprint² (~1.6 of them beyond the first bounce,
+//! the ones that merge there by default), on caustic-glass 0.3 and on
+//! the pool 0.14 (on the floor under the water). These figures, and the
+//! measurements below those of the `vcm` module doc, are from when every
+//! vertex merged (`directmerges always`) and K was 2: the Cornell box was
+//! best at 0.7–1 footprint (16 s: relMSE 0.0011–0.0012; 0.0035 at 3),
+//! caustic-glass at 3–5 (0.021–0.028; 0.044–0.069 at 1), the pool at 3
+//! (0.032; 0.043 at 1, 0.065 at 6). Without the direct merges the Cornell
+//! box is best near 2 footprints.
 //!
 //! So without a written `radius` the first iteration's radius is the one
 //! whose disk holds [`TARGET_NEIGHBOURS`] other light vertices around the
-//! median stored vertex — the k-nearest-neighbour radius of photon mapping
+//! median stored vertex, counting only vertices that merge (beyond the
+//! first bounce unless `directmerges always`) — the k-nearest-neighbour radius of photon mapping
 //! [Jensen 2001, §7.2], taken once for the whole image. A pilot light pass
 //! (a fixed pass index of its own, so every process of a `--pass-range`
 //! render finds the same radius and passes stay independent) stores its
@@ -27,15 +28,16 @@
 //! holds almost every vertex, cannot choose an absurd kernel; with no
 //! vertex at all the footprint default stays.
 //!
-//! Checked beyond the three scenes it was fitted on (relMSE against long
-//! path-traced references): env-metals (an environment light; the pilot
+//! Checked (with K = 2 and every vertex merging) beyond the three scenes
+//! it was fitted on (relMSE against long path-traced references): env-metals (an environment light; the pilot
 //! takes the upper bound, 6 footprints; 8 s, one seed) 0.00022 against
 //! 0.00024 at one footprint; killeroo-simple at 176² (4.7 footprints; 16 s,
 //! two seeds) 0.0015–0.0018 against 0.0014–0.0017, 8 % worse: its light
 //! vertices spread over a floor far larger than the view, and the median
 //! vertex, not the median visible point, sets the radius.
 
-use super::mis::Factors;
+use super::light::LightVertex;
+use super::mis::{DirectMerges, Factors};
 use super::VcmIntegrator;
 use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::RenderContext;
@@ -45,7 +47,7 @@ use std::sync::atomic::AtomicU64;
 
 /// Other light vertices the default radius's disk holds around the median
 /// stored vertex (module docs).
-pub const TARGET_NEIGHBOURS: f32 = 2.0;
+pub const TARGET_NEIGHBOURS: f32 = 3.0;
 
 /// Bounds of the default radius, in pixel footprints.
 pub const MIN_FOOTPRINTS: f32 = 0.5;
@@ -76,7 +78,7 @@ pub(super) fn density_radius(
     footprint: f32,
 ) -> Option<f32> {
     let n_light = vcm.light_paths(ctx) as f32;
-    let f = Factors::new(footprint, n_light, false, true);
+    let f = Factors::new(footprint, n_light, false, true, DirectMerges::Always);
     let lambda = *pass_wavelengths(vcm.settings.seed, PILOT_PASS, 1).group(0);
     let time = vcm.time(ctx, PILOT_PASS);
     // Its own work counter: the pass's progress counts rendered paths only.
@@ -86,10 +88,14 @@ pub(super) fn density_radius(
         ..*ctx
     };
     let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f, false)?;
+    // The vertices that merge count: those next to the light only if they
+    // all do (module doc of `mis`: by default only behind specular ones).
+    let all = vcm.direct_merges() == DirectMerges::Always;
+    let merges = |v: &&LightVertex| all || v.depth >= 2;
     let points: Vec<Vec3> = light
         .chunks()
         .iter()
-        .flat_map(|c| c.iter().map(|v| v.p()))
+        .flat_map(|c| c.iter().filter(merges).map(|v| v.p()))
         .collect();
     light.recycle(&vcm.pools.chunks);
     Some(radius_for_neighbours(&points, footprint))
@@ -156,14 +162,16 @@ mod tests {
     /// Uniform points of density ρ: the disk of radius r around a point
     /// holds Poisson(ρπr²) others, so the K-neighbour radius is
     /// √(K / (ρπ)). At ρ = 10⁶ on the unit square, with footprints of ½, 1
-    /// and 2 times that radius, the pilot's probes hold λ = 32, 32 and 128
-    /// others on average. The median of Poisson(λ) for an integer λ is λ
-    /// (P(X ≤ λ−1) = 0.476 and 0.488, P(X ≤ λ) = 0.546 and 0.523); the
-    /// empirical median over 8192 queries moves the CDF by ~0.0055 (1σ),
-    /// and the points within a probe radius of the square's edge (1.3 % and
-    /// 2.5 % of them) see fewer: the median is λ, or λ − 1 for λ = 128,
-    /// so r is within 0.4 % of the truth. Bound: 1 %, which a count that
-    /// includes the query point itself (λ + 1: −1.5 %) fails.
+    /// and 2 times that radius, the pilot's probes (4 footprints, doubled
+    /// while the median count is below 16) hold λ = 16K, 16K and 64K
+    /// others on average (48, 48, 192 for K = 3). The median of Poisson(λ)
+    /// for an integer λ is λ (P(X ≤ λ−1) < ½ ≤ P(X ≤ λ)); the empirical
+    /// median over 8192 queries moves the CDF by ~0.0055 (1σ, about a
+    /// tenth of a count here), and the points within a probe radius of the
+    /// square's edge (2–3 % of them) see fewer: the median is λ or λ − 1,
+    /// so r is within 1/(2λ) ≈ 1 % of the truth and in fact nearer. Bound:
+    /// 1 %; a count that includes the query point itself is off by +1 on
+    /// every query.
     #[test]
     fn uniform_points_give_the_k_neighbour_radius() {
         let n = 1_000_000;
