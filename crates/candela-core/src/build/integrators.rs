@@ -467,8 +467,11 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
 /// (`integrator::vcm::mis`); all of them in the modes whose only technique
 /// for direct light they are.
 fn vcm_direct_merges(ck: &Check<'_>, mode: VcmMode) -> Result<DirectMerges, BuildError> {
-    let connects = matches!(mode, VcmMode::Vcm | VcmMode::Bpt | VcmMode::Lt);
-    let default = if connects { "afterspecular" } else { "always" };
+    let default = if mode.merges_only() {
+        "always"
+    } else {
+        "afterspecular"
+    };
     let name = ck.params.get_string("directmerges", default)?;
     let Some(d) = DirectMerges::from_name(&name) else {
         return Err(ck.error(
@@ -476,7 +479,7 @@ fn vcm_direct_merges(ck: &Check<'_>, mode: VcmMode) -> Result<DirectMerges, Buil
             format!("\"{name}\" is unknown (known: {})", DirectMerges::NAMES),
         ));
     };
-    if d != DirectMerges::Always && !connects {
+    if d != DirectMerges::Always && mode.merges_only() {
         return Err(ck.error(
             "directmerges",
             format!("\"{name}\" needs connections (mode \"vcm\"): this mode has no other technique for direct light"),

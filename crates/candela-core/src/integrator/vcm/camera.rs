@@ -414,7 +414,9 @@ impl CameraVisitor<'_, '_> {
         let Some(grid) = self.cp.grid else { return };
         let max_depth = self.vcm.settings.max_depth;
         let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
-        let after_delta = self.arrived_delta;
+        // Light vertices next to the light merge here only where that merge
+        // exists ([`Factors::merges_at`]); the rest always do.
+        let merge_direct = f.merges_at(true, self.arrived_delta);
         let r2 = self.cp.radius * self.cp.radius;
         let x = Surfel {
             p: v.p(),
@@ -423,7 +425,7 @@ impl CameraVisitor<'_, '_> {
         };
         let mut sum = SampledSpectrum::zero();
         grid.for_each_within(v.p(), self.cp.radius, |ph| {
-            if ph.depth + v.depth > max_depth + 1 || !f.merges_at(ph.depth == 1, after_delta) {
+            if ph.depth + v.depth > max_depth + 1 || (ph.depth == 1 && !merge_direct) {
                 return;
             }
             let Some(c) = gather(&x, &ph.surfel, r2) else {

@@ -16,7 +16,7 @@
 //! array, into freshly faulted pages, was a serial memcpy of ~12 MB per
 //! iteration at 128².
 
-use super::mis::{weight, Deferred, Factors, Partial};
+use super::mis::{weight, Deferred, DirectMerges, Factors, Partial};
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
 use crate::film::SplatBuffer;
@@ -455,8 +455,8 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
                 self.f,
                 merge_here,
             );
-            let deferred = next_to_light && !merge_here && self.f.merges_at(true, true);
-            self.first = deferred.then_some(merge);
+            let waits = next_to_light && self.f.direct == DirectMerges::AfterSpecular;
+            self.first = waits.then_some(merge);
         }
         let d2 = if self.prev.at_infinity {
             1.0

@@ -16,8 +16,9 @@
 //! So without a written `radius` the first iteration's radius is the one
 //! whose disk holds [`TARGET_NEIGHBOURS`] other light vertices around the
 //! median stored vertex, counting only vertices that merge (beyond the
-//! first bounce unless `directmerges always`) — the k-nearest-neighbour radius of photon mapping
-//! [Jensen 2001, §7.2], taken once for the whole image. A pilot light pass
+//! first bounce unless `directmerges always`) — the k-nearest-neighbour
+//! radius of photon mapping [Jensen 2001, §7.2], taken once for the whole
+//! image. A pilot light pass
 //! (a fixed pass index of its own, so every process of a `--pass-range`
 //! render finds the same radius and passes stay independent) stores its
 //! vertices; around every `stride`-th of them (at most [`QUERIES`]) the
@@ -29,7 +30,8 @@
 //! vertex at all the footprint default stays.
 //!
 //! Checked (with K = 2 and every vertex merging) beyond the three scenes
-//! it was fitted on (relMSE against long path-traced references): env-metals (an environment light; the pilot
+//! it was fitted on (relMSE against long path-traced references):
+//! env-metals (an environment light; the pilot
 //! takes the upper bound, 6 footprints; 8 s, one seed) 0.00022 against
 //! 0.00024 at one footprint; killeroo-simple at 176² (4.7 footprints; 16 s,
 //! two seeds) 0.0015–0.0018 against 0.0014–0.0017, 8 % worse: its light
