@@ -7,7 +7,7 @@
 //! ones computed at the connection) must equal densities recomputed from
 //! scratch along the whole path, and the MIS weights of all strategies of
 //! that path must sum to 1; the weight used must equal the product-form
-//! p_s^β / Σ p_k^β computed in f64.
+//! p_s^β / Σ p_k^β of the densities it used, computed in f64.
 
 use super::connect::{strategy, ConnectCtx};
 use super::density::{pdf, pdf_light_origin};
@@ -193,11 +193,17 @@ fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut 
         view.s,
         view.t
     );
+    // The recursion against the product form of the same densities: only
+    // f32 arithmetic separates them. The densities themselves were checked
+    // against the brute force above; comparing this weight with the product
+    // form of the brute-force densities would mix in their geometric
+    // rounding, which compounds over long paths (a diffuse path bouncing
+    // in a corner, vertices 1e-3 apart, differs by 0.4 % at s = 6).
     let w = w as f64;
     let beta = if h == MisHeuristic::Power { 2 } else { 1 };
-    let wb = product_weight(rs, x0, &brute, view.s, beta);
+    let wb = product_weight(rs, x0, &used, view.s, beta);
     assert!(
-        (w - wb).abs() <= 1e-3 * wb.max(1e-6),
+        (w - wb).abs() <= 1e-4 * wb.max(1e-6),
         "weight {w} vs product form {wb} (s={}, t={})",
         view.s,
         view.t
