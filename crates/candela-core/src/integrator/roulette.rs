@@ -14,13 +14,26 @@
 //!   relative indices of the refractions so far: radiance transport scales
 //!   β by 1/η² entering glass, which says nothing about the path's worth, so
 //!   the test undoes it.
-//! - [`Roulette::Bidirectional`] (BDPT's camera and light subpaths and the
-//!   light tracer): from d = 4 on, q = max(0.05, 1 − m). Subpaths are short
-//!   and every vertex is reused by many connections, so the first three are
-//!   always kept; the 0.05 floor bounds the length of paths that keep their
-//!   power (in a white furnace m stays 1). Light subpaths are traced in
-//!   importance mode, where refraction does not scale β, so the walker
-//!   passes η² = 1 for them (see [`crate::integrator::subpath`]).
+//! - [`Roulette::Bidirectional`] (BDPT's, VCM's and the light tracer's camera
+//!   and light subpaths): from d = 4 on, q = max(0.05, 1 − m). Subpaths are
+//!   short and every vertex is reused by many connections, so the first
+//!   three are always kept; the 0.05 floor bounds the length of paths that
+//!   keep their power (in a white furnace m stays 1). Light subpaths are
+//!   traced in importance mode, where refraction does not scale β, so the
+//!   walker passes η² = 1 for them (see [`crate::integrator::subpath`]).
+//!
+//! The walker ([`crate::integrator::subpath`]) measures m against the walk's
+//! starting throughput: it passes η² / max_λ β₀ as the scale, so m is the
+//! share of its start a subpath still carries. For a camera subpath β₀ is
+//! the camera ray's weight, 1 for the pinhole, and nothing changes; for a
+//! light subpath β₀ is the light's power over the sampling densities, whose
+//! size is set by the scene's units of emission. Against 1 itself, a light
+//! subpath of the Cornell box (β₀ ≈ 0.08) was ended at its fourth vertex
+//! with probability ≈ 0.96, and survivors came back 25 times as bright,
+//! while one of the pool (an 8000-nit lamp) was never played. Measured at
+//! equal time (16 s, 2 threads, the Cornell box at 128², relMSE against a
+//! long path-traced reference, seed 1): bdpt 0.000735 → 0.000544, the light
+//! tracer 0.00192 → 0.00094, vcm 0.000542 → 0.000467 (seeds 2 and 3 alike).
 //! - [`Roulette::Photon`] (photon shooting): at every scattering,
 //!   q = 1 − min(1, m′/m) with m, m′ = max_λ β before and after it, so a
 //!   surviving photon keeps roughly the power it had and the photons of a
@@ -36,7 +49,8 @@ use crate::spectrum::SampledSpectrum;
 pub enum Roulette {
     /// The path tracer's: q = 1 − max β·η² from depth 2.
     Throughput,
-    /// BDPT's and the light tracer's: q = max(0.05, 1 − max β·η²) from depth 4.
+    /// BDPT's, VCM's and the light tracer's: q = max(0.05, 1 − max β·η²)
+    /// from depth 4, β relative to the walk's start (module doc).
     Bidirectional,
     /// Photons': q = 1 − min(1, max β′ / max β) at every scattering.
     Photon,
@@ -45,7 +59,8 @@ pub enum Roulette {
 impl Roulette {
     /// The probability of ending the path after scattering at depth `depth`,
     /// with throughput `before` the scattering and `after` it, and `eta_scale`
-    /// the product of η² over its refractions; `None` when the rule plays no
+    /// the product of η² over its refractions (divided by the walk's starting
+    /// max β for the walker's subpaths, module doc); `None` when the rule plays no
     /// roulette there (then no random number is drawn).
     pub fn kill_probability(
         self,

@@ -177,6 +177,9 @@ struct State {
     scattered: bool,
     any_non_specular: bool,
     eta_scale: f32,
+    /// 1 / max_λ of the starting β: roulette weighs the share of it the
+    /// walk still carries, whatever the light's power ([`Roulette`]).
+    roulette_norm: f32,
 }
 
 /// Walks from `start` until the visitor, the depth limit, absorption or an
@@ -207,6 +210,7 @@ where
         scattered: false,
         any_non_specular: false,
         eta_scale: 1.0,
+        roulette_norm: roulette_norm(&start.beta),
     };
     while !st.beta.is_black() {
         let Some(mut si) = scene.intersect(&st.ray, f32::INFINITY) else {
@@ -322,10 +326,29 @@ where
     }
     st.ray = v.it.spawn_ray(bs.wi);
     match w.roulette {
-        Some(rule) if !rule.play(st.depth, &before, &mut st.beta, st.eta_scale, rng) => {
+        Some(rule)
+            if !rule.play(
+                st.depth,
+                &before,
+                &mut st.beta,
+                st.eta_scale * st.roulette_norm,
+                rng,
+            ) =>
+        {
             Some(End::Absorbed(before))
         }
         _ => None,
+    }
+}
+
+/// 1 / max_λ β of a walk's start, or 1 when that is not a positive finite
+/// number.
+fn roulette_norm(beta: &SampledSpectrum) -> f32 {
+    let m = beta.max_component();
+    if m > 0.0 && m.is_finite() {
+        1.0 / m
+    } else {
+        1.0
     }
 }
 
@@ -340,3 +363,6 @@ fn importance_correction(v: &Vertex, wi: crate::math::Vec3) -> f32 {
     }
     v.wo.dot(ns).abs() * wi.dot(ng).abs() / den
 }
+
+#[cfg(test)]
+mod tests;
