@@ -67,8 +67,8 @@ fn light_vertices(l: f32, n: u64) -> (u64, f32) {
 
 /// Roulette weighs the share of its starting power a light subpath still
 /// carries, so how long light subpaths are does not depend on the
-/// units of emission. Under the old rule (the throughput itself against
-/// 1) the subpaths of the box lit by L = 1, starting with β ≈ 0.011 (the
+/// units of emission. Under the old rule, which played the throughput
+/// itself against one, the subpaths of the box lit by L = 1, starting with β ≈ 0.011 (the
 /// spectral units of an RGB illuminant), were nearly all ended at the
 /// fourth vertex, and those of the box lit by L = 1000 (β ≈ 11) not
 /// before their power fell below 1: the counts differed.
