@@ -79,7 +79,8 @@
 //! not exist. `always` merges them everywhere (the modes without
 //! connections must), `never` nowhere. Measured at equal time (16 s, 2
 //! threads, half resolution, relMSE against long references, seed 1),
-//! with the pilot's radius at K = 2 (below): the Cornell box 0.000607 against
+//! with the pilot's radius at K = 2 (below) and before the light-subpath
+//! roulette fix: the Cornell box 0.000607 against
 //! `always`'s 0.000714, with no bright seam where a lit box top meets its
 //! dimmer side (the merge kernel averaged the two faces' direct light
 //! there, +0.15 on the seam's pixels at radius 0.064); the pool 0.0145
@@ -91,14 +92,17 @@
 //! merging light vertices around the median one, within ½–6 pixel
 //! footprints ([`pilot`]). A merge's noise is set by the vertices in its
 //! disk and its kernel bias by the radius, and the vertex density per
-//! pixel footprint differs twentyfold between these scenes. Measured as
-//! above (16 s, two seeds where given) with the neighbour count K: the
-//! Cornell box 0.000607 (K = 2), 0.000557–0.000582 (3), 0.000530–0.000597
-//! (4), 0.000491 (8); the pool 0.0145 (2), 0.0148–0.0178 (3), 0.0197–0.0212
-//! (4), 0.0335 (8); caustic-glass 0.0127–0.0135 at every K (its radius is
-//! the 6-footprint bound). Diffuse interreflection wants many neighbours,
-//! caustics few; K = 3 keeps both within the equal-time targets of the
-//! benchmark (`bench/vcm_equal_time.py`).
+//! pixel footprint differs twentyfold between these scenes. Measured at
+//! 16 s as above, seeds 1 and 2, once light subpaths were played by the
+//! share of their starting power ([`crate::integrator::roulette`]; they
+//! used to end near the fourth vertex), with the neighbour count K: the
+//! Cornell box 0.000551–0.000703 (K = 2), 0.000490–0.000589 (3),
+//! 0.000483–0.000501 (4); the pool 0.0147–0.0150 (2), 0.0164–0.0209 (3),
+//! 0.0222–0.0265 (4); caustic-glass 0.0148–0.0155 (2), 0.0127–0.0137 (3),
+//! 0.0138–0.0141 (4). Diffuse interreflection wants many neighbours,
+//! caustics few; K = 3 keeps all three scenes inside the equal-time
+//! targets of the benchmark (`bench/vcm_equal_time.py`), where K = 2
+//! missed on the Cornell box and K = 4 on the pool.
 //!
 //! **α.** The default 0.75 is the paper's (Georgiev et al. 2012, §7 and
 //! SmallVCM's default): VCM's merges only carry the paths connections
