@@ -267,11 +267,14 @@ pub fn sample_visible_wavelength(u: f32) -> f32 {
 /// y = 0.8569106 − 1.827502 u, λ = 538 − 138.88889 atanh y, and since
 /// 0.0072 · 138.88889 = 1, cosh(0.0072(λ − 538)) = cosh(atanh y) = 1/√(1 − y²),
 /// so the density 0.003939804 / cosh²(…) is 0.003939804 (1 − y²): no
-/// hyperbolic cosine per wavelength.
+/// hyperbolic cosine per wavelength. atanh y is taken as ½ ln((1 + y)/(1 − y))
+/// (one `ln`, cheaper than the `log1p` inside `f32::atanh`; y ∈ [−0.971,
+/// 0.857] keeps both factors away from 0, so the quotient loses at most an
+/// ulp and λ moves by under 10⁻⁴ nm).
 #[inline]
 pub fn sample_visible_wavelength_with_pdf(u: f32) -> (f32, f32) {
     let y = 0.856_910_6 - 1.827_502 * u;
-    let lambda = 538.0 - 138.888_89 * y.atanh();
+    let lambda = 538.0 - 69.444_445 * ((1.0 + y) / (1.0 - y)).ln();
     (lambda, 0.003_939_804 * (1.0 - y * y))
 }
 
