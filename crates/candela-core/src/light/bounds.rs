@@ -126,16 +126,6 @@ fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
     }
 }
 
-/// sin(a ⊖ b) from sines and cosines: 0 when a ≤ b.
-#[inline]
-fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
-    if cos_a > cos_b {
-        0.0
-    } else {
-        sin_a * cos_b - cos_a * sin_b
-    }
-}
-
 /// The importance of `b` at `p` with normal `n`; finite and ≥ 0.
 pub(crate) fn importance(b: &LightBounds, p: Vec3, n: Vec3) -> f32 {
     PreparedBounds::new(b).importance(p, n)
@@ -148,8 +138,8 @@ pub(crate) fn importance(b: &LightBounds, p: Vec3, n: Vec3) -> f32 {
 pub(crate) struct PreparedBounds {
     /// Box centre.
     pc: Vec3,
-    /// Bounding sphere (centre, radius²).
-    sphere: (Vec3, f32),
+    /// Radius² of the bounding sphere, which is centred on `pc`.
+    r2: f32,
     /// |diagonal| / 2 (pbrt-v4's lower bound of d²).
     half_diagonal: f32,
     w: Vec3,
@@ -163,10 +153,10 @@ pub(crate) struct PreparedBounds {
 impl PreparedBounds {
     /// The prepared form of `b`.
     pub fn new(b: &LightBounds) -> Self {
-        let (c, r) = b.bounds.bounding_sphere();
+        let (_, r) = b.bounds.bounding_sphere();
         Self {
             pc: b.bounds.centroid(),
-            sphere: (c, r * r),
+            r2: r * r,
             half_diagonal: b.bounds.diagonal().length() / 2.0,
             w: b.w,
             phi: b.phi,
@@ -177,45 +167,50 @@ impl PreparedBounds {
         }
     }
 
-    /// sin θb and cos θb of the cone `p` sees the bounding sphere under
-    /// (θb = π inside it). The sine is computed directly as r/d: from the
-    /// cosine it would vanish in f32 below θb ≈ 3·10⁻⁴ (cos θb rounds to 1),
-    /// and the bound would lose the light's extent.
-    #[inline]
-    fn subtended_sin_cos(&self, p: Vec3) -> (f32, f32) {
-        let (center, r2) = self.sphere;
-        let d2 = p.distance_squared(center);
-        if d2 <= r2 {
-            return (0.0, -1.0);
-        }
-        let sin2 = r2 / d2;
-        (sin2.sqrt(), safe_sqrt(1.0 - sin2))
-    }
-
     /// The importance at `p` with normal `n` (module doc); finite and ≥ 0.
+    ///
+    /// The bounding sphere is centred on the box centre, so one offset
+    /// p − pc gives the distance bound, the direction and the subtended
+    /// cone. sin θb is r/d directly: from the cosine it would vanish in f32
+    /// below θb ≈ 3·10⁻⁴ (cos θb rounds to 1), and the bound would lose the
+    /// light's extent. Sines are only taken where a clamped difference
+    /// needs them: θw ≤ θo (p inside the emission cone) makes θx = 0 and
+    /// θ' = 0, and θi ≤ θb makes that factor 1.
     #[inline]
     pub fn importance(&self, p: Vec3, n: Vec3) -> f32 {
-        let pc = self.pc;
-        let d2 = p.distance_squared(pc).max(self.half_diagonal);
-        let wi = (p - pc).normalize_or_zero();
+        let v = p - self.pc;
+        let dist2 = v.length_squared();
+        let d2 = dist2.max(self.half_diagonal);
+        let wi = v.normalize_or_zero();
+        let (sin_b, cos_b) = if dist2 <= self.r2 {
+            (0.0, -1.0)
+        } else {
+            let sin2 = self.r2 / dist2;
+            (sin2.sqrt(), safe_sqrt(1.0 - sin2))
+        };
         let mut cos_w = self.w.dot(wi);
         if self.two_sided {
             cos_w = cos_w.abs();
         }
-        let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
-        let (sin_b, cos_b) = self.subtended_sin_cos(p);
         // θx = θw ⊖ θo, then θ' = θx ⊖ θb.
-        let cos_x = cos_sub_clamped(sin_w, cos_w, self.sin_o, self.cos_o);
-        let sin_x = sin_sub_clamped(sin_w, cos_w, self.sin_o, self.cos_o);
-        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        let cos_p = if cos_w > self.cos_o {
+            1.0
+        } else {
+            let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
+            let cos_x = cos_w * self.cos_o + sin_w * self.sin_o;
+            let sin_x = sin_w * self.cos_o - cos_w * self.sin_o;
+            cos_sub_clamped(sin_x, cos_x, sin_b, cos_b)
+        };
         if cos_p <= self.cos_e {
             return 0.0;
         }
         let mut imp = self.phi * cos_p;
         if n != Vec3::ZERO {
             let cos_i = wi.dot(n).abs();
-            let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
-            imp *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+            if cos_i <= cos_b {
+                let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
+                imp *= cos_i * cos_b + sin_i * sin_b;
+            }
         }
         if d2 == 0.0 {
             // p at a point light: the bound is unbounded; keep it finite.
