@@ -274,7 +274,7 @@ pub fn sample_visible_wavelength(u: f32) -> f32 {
 #[inline]
 pub fn sample_visible_wavelength_with_pdf(u: f32) -> (f32, f32) {
     let y = 0.856_910_6 - 1.827_502 * u;
-    let lambda = 538.0 - 69.444_445 * ((1.0 + y) / (1.0 - y)).ln();
+    let lambda = 538.0 - 69.444_44 * ((1.0 + y) / (1.0 - y)).ln();
     (lambda, 0.003_939_804 * (1.0 - y * y))
 }
 
