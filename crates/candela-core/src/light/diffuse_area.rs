@@ -212,12 +212,13 @@ impl DiffuseAreaLight {
         self.two_sided
     }
 
-    fn shape_ctx(ctx: &LightSampleContext) -> ShapeSampleContext {
+    fn shape_ctx(&self, ctx: &LightSampleContext) -> ShapeSampleContext {
         ShapeSampleContext {
             p: ctx.p,
             p_error: ctx.p_error,
             n: ctx.n,
             ns: ctx.ns,
+            need_uv: self.alpha.is_some() || matches!(self.emission, Emission::Image { .. }),
         }
     }
 
@@ -274,7 +275,7 @@ impl DiffuseAreaLight {
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightLiSample> {
-        let ss = self.sample_from(&Self::shape_ctx(ctx), u)?;
+        let ss = self.sample_from(&self.shape_ctx(ctx), u)?;
         let d = ss.intr.p - ctx.p;
         if ss.pdf.0 == 0.0 || d.length_squared() == 0.0 {
             return None;
@@ -294,7 +295,7 @@ impl DiffuseAreaLight {
 
     /// Density of [`sample_li`](Self::sample_li) for direction `wi`.
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> PdfSolidAngle {
-        self.shape.pdf_from(&Self::shape_ctx(ctx), wi)
+        self.shape.pdf_from(&self.shape_ctx(ctx), wi)
     }
 
     /// Point by area (`u1`), cosine-weighted direction (`u2`; `u2.x` also

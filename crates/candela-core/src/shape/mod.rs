@@ -89,12 +89,22 @@ pub struct ShapeSampleContext {
     pub n: Vec3,
     /// Shading normal at `p` (zero in media / free space).
     pub ns: Vec3,
+    /// Whether the sampled point's (u, v) is read (textured or cut-out
+    /// emitters); without it a sphere sampled by its cone skips the inverse
+    /// transform, arctangent and arccosine that (u, v) costs.
+    pub need_uv: bool,
 }
 
 impl ShapeSampleContext {
-    /// Context from its parts.
+    /// Context from its parts (with (u, v)).
     pub fn new(p: Vec3, p_error: Vec3, n: Vec3, ns: Vec3) -> Self {
-        Self { p, p_error, n, ns }
+        Self {
+            p,
+            p_error,
+            n,
+            ns,
+            need_uv: true,
+        }
     }
     /// Context for a point in a medium or free space (no normal, no error).
     pub fn from_point(p: Vec3) -> Self {

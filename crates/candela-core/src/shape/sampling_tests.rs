@@ -441,3 +441,50 @@ fn solid_angle_estimates_match_quadrature_for_cylinders_and_patches() {
         assert_within_5_sigma(name, mc_solid_angle(&shape, &ctx, n, 7), exact);
     }
 }
+
+/// A sphere gives the same point, normal and density whether or not (u, v)
+/// is asked for (sampled by its cone it then leaves (u, v) out), and when
+/// it is, the (u, v) a ray hitting that point finds.
+#[test]
+fn sphere_samples_agree_with_and_without_uv() {
+    let mut r = Pcg32::new(9, 4);
+    for (name, shape) in test_shapes() {
+        if !name.starts_with("sphere") {
+            continue;
+        }
+        let c = shape.bounds().centroid();
+        let mut compared = 0;
+        for _ in 0..500 {
+            let with = ShapeSampleContext::from_point(c + dir(&mut r) * 4.0);
+            let without = ShapeSampleContext {
+                need_uv: false,
+                ..with
+            };
+            let u = u2(&mut r);
+            let (Some(a), Some(b)) = (shape.sample_from(&with, u), shape.sample_from(&without, u))
+            else {
+                assert!(shape.sample_from(&without, u).is_none(), "{name}");
+                continue;
+            };
+            assert_eq!(
+                (a.intr.p, a.intr.n, a.pdf.0),
+                (b.intr.p, b.intr.n, b.pdf.0),
+                "{name}"
+            );
+            let wi = (a.intr.p - with.p).normalize();
+            let Some(h) = shape.intersect(&with.spawn_ray(wi), f32::INFINITY) else {
+                continue;
+            };
+            if h.si.p().distance(a.intr.p) < 1e-4 {
+                assert!(
+                    (h.si.it.uv - a.intr.uv).abs().max_element() < 1e-3,
+                    "{name}: {} vs {}",
+                    h.si.it.uv,
+                    a.intr.uv
+                );
+                compared += 1;
+            }
+        }
+        assert!(compared > 100, "{name}: {compared}");
+    }
+}

@@ -309,7 +309,12 @@ impl Sphere {
         let frame = Frame::from_z((c - ctx.p).normalize());
         let n_out = frame.from_local(-w);
         let p = c + r * n_out;
-        let p_obj = self.render_from_object.inverse().point(p);
+        let uv = if ctx.need_uv {
+            let p_obj = self.render_from_object.inverse().point(p);
+            self.uv(p_obj, phi_of(p_obj))
+        } else {
+            Vec2::ZERO
+        };
         let intr = Interaction {
             p,
             p_error: gamma(5) * p.abs(),
@@ -318,7 +323,7 @@ impl Sphere {
             } else {
                 n_out
             },
-            uv: self.uv(p_obj, phi_of(p_obj)),
+            uv,
             time: 0.0,
         };
         let pdf = PdfSolidAngle(1.0 / (2.0 * PI * one_minus_cos_max));
