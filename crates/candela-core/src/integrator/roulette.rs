@@ -21,6 +21,12 @@
 //!   keep their power (in a white furnace m stays 1). Light subpaths are
 //!   traced in importance mode, where refraction does not scale β, so the
 //!   walker passes η² = 1 for them (see [`crate::integrator::subpath`]).
+//! - [`Roulette::Photon`] (photon shooting): at every scattering,
+//!   q = 1 − min(1, m′/m) with m, m′ = max_λ β before and after it, so a
+//!   surviving photon keeps roughly the power it had and the photons of a
+//!   map stay of nearly equal power, which keeps density estimates smooth
+//!   [Jensen 2001, §5.1.2; pbrt-v4 SPPM photon pass]. Absorption (ρ) rather
+//!   than path length is what ends photons.
 //!
 //! The walker ([`crate::integrator::subpath`]) measures m against the walk's
 //! starting throughput: it passes η² / max_λ β₀ as the scale, so m is the
@@ -34,12 +40,6 @@
 //! equal time (16 s, 2 threads, the Cornell box at 128², relMSE against a
 //! long path-traced reference, seed 1): bdpt 0.000735 → 0.000544, the light
 //! tracer 0.00192 → 0.00094, vcm 0.000542 → 0.000467 (seeds 2 and 3 alike).
-//! - [`Roulette::Photon`] (photon shooting): at every scattering,
-//!   q = 1 − min(1, m′/m) with m, m′ = max_λ β before and after it, so a
-//!   surviving photon keeps roughly the power it had and the photons of a
-//!   map stay of nearly equal power, which keeps density estimates smooth
-//!   [Jensen 2001, §5.1.2; pbrt-v4 SPPM photon pass]. Absorption (ρ) rather
-//!   than path length is what ends photons.
 
 use crate::sampling::PathRng;
 use crate::spectrum::SampledSpectrum;

@@ -66,12 +66,12 @@ fn light_vertices(l: f32, n: u64) -> (u64, f32) {
 }
 
 /// Roulette weighs the share of its starting power a light subpath still
-/// carries, so how long light subpaths are does not depend on the
-/// units of emission. Under the old rule, which played the throughput
-/// itself against one, the subpaths of the box lit by L = 1, starting with β ≈ 0.011 (the
-/// spectral units of an RGB illuminant), were nearly all ended at the
-/// fourth vertex, and those of the box lit by L = 1000 (β ≈ 11) not
-/// before their power fell below 1: the counts differed.
+/// carries, so how long light subpaths are does not depend on the units
+/// of emission. Under the old rule, which played the throughput itself
+/// against one, the subpaths of the box lit by L = 1, starting with
+/// β ≈ 0.011 (the spectral units of an RGB illuminant), were nearly all
+/// ended at the fourth vertex, and those of the box lit by L = 1000
+/// (β ≈ 11) not before their power fell below 1: the counts differed.
 #[test]
 fn light_subpath_lengths_do_not_depend_on_the_lights_units() {
     let (dim, beta_dim) = light_vertices(1.0, 2000);
