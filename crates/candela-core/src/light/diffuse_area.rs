@@ -268,6 +268,12 @@ impl DiffuseAreaLight {
         }
     }
 
+    /// True unless [`sample_li`](Self::sample_li) samples the shape's
+    /// visible cone (spheres) instead of its area.
+    pub fn samples_li_by_area(&self) -> bool {
+        self.triangle.is_some() || !matches!(self.shape, Shape::Sphere(_))
+    }
+
     /// Samples a point on the shape as seen from `ctx`.
     pub fn sample_li(
         &self,

@@ -370,6 +370,17 @@ impl Light {
         }
     }
 
+    /// True when [`sample_li`](Self::sample_li) picks an area light's point
+    /// with the uniform-area density of its emission sampling (every shape
+    /// but the sphere, whose visible cone is sampled), so that next-event
+    /// estimation's density of a point does not depend on the receiver.
+    pub fn samples_li_by_area(&self) -> bool {
+        match self {
+            Light::DiffuseArea(l) => l.samples_li_by_area(),
+            _ => true,
+        }
+    }
+
     /// Total emitted power Φ (W) at the given wavelengths.
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         dispatch!(self, l => l.phi(lambda))

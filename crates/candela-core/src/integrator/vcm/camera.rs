@@ -19,7 +19,9 @@
 //! with the film's filter weight to a [`FilmTile`], so the camera side
 //! filters exactly as the path tracer does.
 
-use super::light::{light_densities, LightPaths, LightVertex, PrevVertex};
+use super::light::{
+    light_densities, nee_area_density, nee_context, LightPaths, LightVertex, PrevVertex,
+};
 use super::merge::MergeGrid;
 use super::mis::{weight, Deferred, Factors, Partial};
 use super::resample::Resampler;
@@ -36,6 +38,7 @@ use crate::integrator::subpath::{
 use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::interaction::SurfaceInteraction;
+use crate::light::{LightSampleContext, LightType};
 use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
 use crate::sampling::PathRng;
@@ -122,6 +125,7 @@ impl VcmIntegrator {
             last_after_delta: false,
             specular: true,
             vertices: 0,
+            nee_ctx: LightSampleContext::at_point(ray.o),
             l: SampledSpectrum::zero(),
         };
         let w = Walk {
@@ -164,6 +168,9 @@ struct CameraVisitor<'a, 'b> {
     specular: bool,
     /// Surface vertices visited.
     vertices: u32,
+    /// Where next-event estimation at the vertex left last would have
+    /// sampled a light from (its emission weight, [`nee_area_density`]).
+    nee_ctx: LightSampleContext,
     l: SampledSpectrum,
 }
 
@@ -196,6 +203,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
         self.prev = PrevVertex::of(v);
         self.vertices += 1;
         self.emission(v, lambda);
+        self.nee_ctx = nee_context(v);
         let max_depth = self.vcm.settings.max_depth;
         let Some(bsdf) = &v.bsdf else {
             return Flow::Continue;
@@ -286,6 +294,14 @@ impl CameraVisitor<'_, '_> {
             return;
         }
         let (direct, emission, _) = light_densities(scene, id, &v.it, v.wo);
+        // Next-event estimation at the vertex left would have sampled this
+        // point with its own density (light.rs, `nee_area_density`).
+        let light = scene.light(id);
+        let direct = if light.light_type() == LightType::Area && !light.samples_li_by_area() {
+            nee_area_density(scene, id, &v.it, &self.nee_ctx)
+        } else {
+            direct
+        };
         let w = if v.depth == 1 {
             1.0
         } else {
@@ -315,6 +331,13 @@ impl CameraVisitor<'_, '_> {
         if direct <= 0.0 {
             return;
         }
+        // An area light point's density is the one this sample was drawn
+        // with, per unit area (light.rs, `nee_area_density`).
+        let direct = if light.light_type() == LightType::Area && !light.samples_li_by_area() {
+            ls.pmf * ls.pdf.0 * cos_light / (e.p() - v.p()).length_squared()
+        } else {
+            direct
+        };
         let bsdf_dir = if light.is_hittable() {
             bsdf.pdf(v.wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
                 .0

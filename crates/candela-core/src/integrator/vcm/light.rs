@@ -28,7 +28,7 @@ use crate::integrator::subpath::{
 use crate::integrator::RenderContext;
 use crate::interaction::SurfaceInteraction;
 use crate::interaction::{Interaction, LightId};
-use crate::light::LightType;
+use crate::light::{LightSampleContext, LightType};
 use crate::math::{Ray, Vec3};
 use crate::sampling::{hash_u64s, PathRng, StreamRng};
 use crate::scene::Scene;
@@ -227,6 +227,45 @@ impl Pool<SplatBuffer> {
     }
 }
 
+/// The density with which next-event estimation at `ctx` (the receiver)
+/// samples the point `x0` of area light `id`: the selection probability
+/// times the light's own [`Light::pdf_li`] (a sphere's cone sampling),
+/// taken to area measure at `x0` [Veach 1997, eq. 8.10].
+///
+/// The MIS weights of every technique of a path that starts at a light
+/// whose next-event sampling is not by area use this density for s = 1, not
+/// the emission's uniform-area one (module doc of [`super::mis`],
+/// "Next-event density").
+///
+/// [`Light::pdf_li`]: crate::light::Light::pdf_li
+pub fn nee_area_density(
+    scene: &Scene,
+    id: LightId,
+    x0: &Interaction,
+    ctx: &LightSampleContext,
+) -> f32 {
+    let d = x0.p - ctx.p;
+    let d2 = d.length_squared();
+    if d2 <= 0.0 {
+        return 0.0;
+    }
+    let wi = d / d2.sqrt();
+    let pdf = scene.light(id).pdf_li(ctx, wi).0;
+    scene.light_sampler().pmf(id) * pdf * x0.n.dot(wi).abs() / d2
+}
+
+/// The next-event context at vertex `v` (as [`Receiver::at_vertex`] makes it).
+///
+/// [`Receiver::at_vertex`]: crate::integrator::nee::Receiver::at_vertex
+pub fn nee_context(v: &Vertex) -> LightSampleContext {
+    LightSampleContext {
+        p: v.it.p,
+        p_error: v.it.p_error,
+        n: v.it.n,
+        ns: v.ns,
+    }
+}
+
 /// Next-event and emission densities of light `id` emitting from `it`
 /// towards `w` (the direction light travels), each with the light's
 /// selection probability, and the cosine at the light (1 off surfaces)
@@ -351,6 +390,11 @@ impl VcmIntegrator {
         if emission <= 0.0 {
             return;
         }
+        // A sphere light's next-event density depends on the receiver x_1:
+        // it enters d_VCM when the walk reaches x_1 (`LightVisitor::vertex`).
+        let by_area = scene.light(id).samples_li_by_area();
+        let nee_from = (ty == LightType::Area && !by_area).then_some((id, ls.vertex.it));
+        let direct = if nee_from.is_some() { 1.0 } else { direct };
         let mis = Partial::light(direct, emission, cos, ty.is_delta(), f);
         if let (true, Some(buf)) = (self.techniques.light_only, buf.as_deref_mut()) {
             self.splat_light_point(ctx, &ls.vertex, &ls, lambda, &mut rng, buf);
@@ -369,6 +413,7 @@ impl VcmIntegrator {
             lambda,
             mis,
             prev: PrevVertex::of(&ls.vertex),
+            nee_from,
             pending: None,
             first: None,
             out,
@@ -416,6 +461,9 @@ struct LightVisitor<'a, 'b> {
     lambda: &'a SampledWavelengths,
     mis: Partial,
     prev: PrevVertex,
+    /// An area light's id and point x_0, until x_1 gives d_VCM its
+    /// next-event density ([`nee_area_density`]).
+    nee_from: Option<(LightId, Interaction)>,
     pending: Option<Scatter>,
     /// The terms of a merge at x_1, until x_2 scatters (module doc of
     /// [`super::mis`]).
@@ -465,6 +513,12 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
         };
         let cos_in = v.wo.dot(v.it.n).abs();
         self.mis.hit(d2, cos_in);
+        if let Some((id, x0)) = self.nee_from.take() {
+            // x_1: d_VCM = mis(p_NEE(x_0 | x_1) / p_emission) · mis(d²/cos)
+            // [tech. rep. eq. 31], started with p_NEE = 1.
+            let p = nee_area_density(self.ctx.scene, id, &x0, &nee_context(v));
+            self.mis.d_vcm *= super::mis::mis(p);
+        }
         if let Some(first) = &mut self.first {
             first.hit(cos_in);
         }

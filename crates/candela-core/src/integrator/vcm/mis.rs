@@ -44,6 +44,22 @@
 //! the camera subpath hitting the light counts it when the vertex it last
 //! left was itself reached by a delta scattering (its d_VC without that
 //! term is [`Deferred::d_vc_without`]).
+//!
+//! **Next-event density.** The technique s = 1 (next-event estimation at
+//! x_1) samples the light point x_0 with the light sampler's own density,
+//! which for a sphere light is uniform over the cone it subtends from x_1,
+//! not uniform over its area as the emission sampling is; SmallVCM and
+//! pbrt-v4's BDPT weigh it with the emission's area density. Weights that
+//! use another density than the sampler's still sum to one (the estimate
+//! stays unbiased), but they no longer favour each technique where it
+//! samples well. So every weight that involves s = 1 uses
+//! p_NEE(x_0 | x_1) = P(light) · p_ω(x_1 → x_0) · |cos θ_0| / d²
+//! ([`super::light::nee_area_density`]): the light subpath multiplies it
+//! into d_VCM on reaching x_1 (eq. 31 with the density known only there),
+//! next-event estimation uses the density it sampled with, and the camera
+//! subpath hitting the light evaluates it from the vertex it left. Shapes
+//! sampled by area (triangles, disks, …) keep the emission's density, which
+//! is then the same number.
 
 /// The heuristic's power applied to a density or density ratio (β = 2)
 /// [Veach 1997, eq. 9.13].

@@ -42,6 +42,11 @@ struct Path {
     light: Emitter,
     /// Light selection × position density (area; 1 for a point light).
     p_pos: f32,
+    /// Light selection × next-event density of x_0 seen from x_1 (area; for
+    /// an area light it differs from `p_pos`: cone sampling of a sphere,
+    /// light.rs `nee_area_density`; else it is `p_pos`, or `p_inf_dir` at
+    /// infinity).
+    p_nee: f32,
     /// Emission direction density (solid angle; 1 for an infinite light's
     /// direction, whose density is in `p_inf_dir`).
     p_dir: f32,
@@ -97,15 +102,17 @@ impl Path {
                 )
             })
             .collect();
+        let p_pos = if light == Emitter::Point {
+            0.5
+        } else {
+            uniform(rng, 0.1, 3.0)
+        };
+        let (p_dir, p_inf_dir) = (uniform(rng, 0.1, 1.0), uniform(rng, 0.05, 2.0));
         Path {
             light,
-            p_pos: if light == Emitter::Point {
-                0.5
-            } else {
-                uniform(rng, 0.1, 3.0)
-            },
-            p_dir: uniform(rng, 0.1, 1.0),
-            p_inf_dir: uniform(rng, 0.05, 2.0),
+            p_pos,
+            p_dir,
+            p_inf_dir,
             delta,
             pl_dir,
             pe_dir,
@@ -114,6 +121,11 @@ impl Path {
             pdf_pixel: uniform(rng, 1e3, 1e5),
             n_light: uniform(rng, 1e3, 1e5),
             radius: uniform(rng, 0.002, 0.05),
+            p_nee: match light {
+                Emitter::Area => uniform(rng, 0.1, 3.0),
+                Emitter::Point => p_pos,
+                Emitter::Infinite => p_inf_dir,
+            },
         }
     }
 
@@ -128,7 +140,7 @@ impl Path {
     /// (direct, emission, cos at the light) as `light_densities` gives them.
     fn light_densities(&self) -> (f32, f32, f32) {
         match self.light {
-            Emitter::Area => (self.p_pos, self.p_pos * self.p_dir, self.seg[0].1),
+            Emitter::Area => (self.p_nee, self.p_pos * self.p_dir, self.seg[0].1),
             Emitter::Point => (self.p_pos, self.p_pos * self.p_dir, 1.0),
             Emitter::Infinite => (self.p_inf_dir, self.p_inf_dir * self.p_pos, 1.0),
         }
@@ -191,7 +203,9 @@ fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
         };
         if ok {
             let n = if s == m + 1 { p.n_light as f64 } else { 1.0 };
-            out.push((Technique::Connect(s), n * light(s) * camera(s)));
+            // Next-event estimation samples x_0 with its own density.
+            let l = if s == 1 { p.p_nee as f64 } else { light(s) };
+            out.push((Technique::Connect(s), n * l * camera(s)));
         }
     }
     let merge_at_1 = match direct {
@@ -216,7 +230,10 @@ fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial
     let seg = |k: usize| p.seg[k];
     // Light subpath: the state at x_1 ..= x_m (light.rs `vertex`).
     let mut lp = vec![Partial::default(); m + 1];
-    let mut st = Partial::light(direct, emission, cos_light, p.light == Emitter::Point, f);
+    // An area light's next-event density enters at x_1 (light.rs).
+    let area = p.light == Emitter::Area;
+    let start = if area { 1.0 } else { direct };
+    let mut st = Partial::light(start, emission, cos_light, p.light == Emitter::Point, f);
     let mut first: Option<Deferred> = None;
     for (k, state) in lp.iter_mut().enumerate().skip(1) {
         if k >= 2 {
@@ -245,6 +262,9 @@ fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial
             seg(k - 1).0
         };
         st.hit(d2, seg(k - 1).2);
+        if k == 1 && area {
+            st.d_vcm *= mis(direct);
+        }
         if let Some(t) = &mut first {
             t.hit(seg(k - 1).2);
         }
@@ -507,4 +527,42 @@ fn merges_next_to_the_light_are_checked_after_specular_and_not() {
         }
     }
     assert!(after > 300 && not > 300, "{after} {not}");
+}
+
+/// An area light's next-event density is its own technique's: giving the
+/// recursion the emission's position density instead (the weights before
+/// `nee_area_density`, right only for area-uniform sampling) is caught on
+/// every area-light path without specular vertices where next-event
+/// estimation or a hit on the light carries more than 1e-3 of the weight
+/// and the two densities differ by more than 20 %.
+#[test]
+fn the_next_event_density_is_the_samplers() {
+    let (mut caught, mut tried) = (0, 0);
+    for p in paths().take(1200) {
+        let differ = (p.p_nee / p.p_pos - 1.0).abs() > 0.2;
+        if p.light != Emitter::Area || !differ || p.delta[1..].iter().any(|&d| d) {
+            continue;
+        }
+        let direct = DirectMerges::AfterSpecular;
+        let brute = brute_force(&p, direct);
+        let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
+        let share: f64 = brute
+            .iter()
+            .filter(|(t, _)| matches!(t, Technique::Connect(0 | 1)))
+            .map(|(_, q)| q * q / total)
+            .sum();
+        if share < 1e-3 {
+            continue;
+        }
+        let given = Path {
+            p_nee: p.p_pos,
+            ..p.clone()
+        };
+        let Some(m) = compare(&p, &given, direct) else {
+            continue;
+        };
+        tried += 1;
+        caught += !m.agrees() as u32;
+    }
+    assert!(tried > 50 && caught == tried, "{caught}/{tried}");
 }
