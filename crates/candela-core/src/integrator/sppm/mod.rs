@@ -31,6 +31,7 @@ use super::photon::ShootSettings;
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
 use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, VisitBuffer, Visits};
+use rayon::prelude::*;
 
 /// α of the radius reduction (Hachisuka & Jensen recommend 2/3).
 pub const ALPHA: f64 = 2.0 / 3.0;
@@ -94,7 +95,10 @@ impl SppmIntegrator {
             return PassOutcome::Cancelled;
         };
         let sensor = ctx.film.sensor();
-        for (j, (p, v)) in st.stats.iter_mut().zip(&out.visits).enumerate() {
+        // Every pixel's update is its own: in parallel (this loop was the
+        // largest serial part of an iteration).
+        let stats = st.stats.par_iter_mut().zip(&out.visits).enumerate();
+        stats.for_each(|(j, (p, v))| {
             let ld = sensor.to_sensor_rgb(v.ld, &v.lambda);
             for (sum, v) in p.ld.iter_mut().zip(ld) {
                 *sum += v as f64;
@@ -110,7 +114,7 @@ impl SppmIntegrator {
                 }
             }
             *p = sppm_update(p, m as f64, phi, ALPHA);
-        }
+        });
         PassOutcome::Done
     }
 }
