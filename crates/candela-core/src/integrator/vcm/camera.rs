@@ -19,9 +19,8 @@
 //! with the film's filter weight to a [`FilmTile`], so the camera side
 //! filters exactly as the path tracer does.
 
-use super::light::{
-    light_densities, nee_area_density, nee_context, LightPaths, LightVertex, PrevVertex,
-};
+use super::densities::{light_densities, nee_area_density, nee_context};
+use super::light::{LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
 use super::mis::{weight, Deferred, Factors, Partial};
 use super::resample::Resampler;
@@ -295,7 +294,7 @@ impl CameraVisitor<'_, '_> {
         }
         let (direct, emission, _) = light_densities(scene, id, &v.it, v.wo);
         // Next-event estimation at the vertex left would have sampled this
-        // point with its own density (light.rs, `nee_area_density`).
+        // point with its own density (densities.rs, `nee_area_density`).
         let light = scene.light(id);
         let direct = if light.light_type() == LightType::Area && !light.samples_li_by_area() {
             nee_area_density(scene, id, &v.it, &self.nee_ctx)
@@ -332,7 +331,7 @@ impl CameraVisitor<'_, '_> {
             return;
         }
         // An area light point's density is the one this sample was drawn
-        // with, per unit area (light.rs, `nee_area_density`).
+        // with, per unit area (densities.rs, `nee_area_density`).
         let direct = if light.light_type() == LightType::Area && !light.samples_li_by_area() {
             ls.pmf * ls.pdf.0 * cos_light / (e.p() - v.p()).length_squared()
         } else {

@@ -44,7 +44,7 @@ struct Path {
     p_pos: f32,
     /// Light selection × next-event density of x_0 seen from x_1 (area; for
     /// an area light it differs from `p_pos`: cone sampling of a sphere,
-    /// light.rs `nee_area_density`; else it is `p_pos`, or `p_inf_dir` at
+    /// densities.rs `nee_area_density`; else it is `p_pos`, or `p_inf_dir` at
     /// infinity).
     p_nee: f32,
     /// Emission direction density (solid angle; 1 for an infinite light's
@@ -221,19 +221,22 @@ fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
     out
 }
 
-/// The light subpath's quantities at x_1 ..= x_m, the camera subpath's at
-/// x_m ..= x_0 and the camera's for its emission weight at x_0, built as
-/// light.rs and camera.rs build them.
-fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial) {
+/// The light subpath's quantities at x_1 ..= x_m, built as light.rs
+/// (`trace_light`, `vertex`) builds them.
+fn light_states(p: &Path, f: &Factors) -> Vec<Partial> {
     let m = p.m();
     let (direct, emission, cos_light) = p.light_densities();
     let seg = |k: usize| p.seg[k];
-    // Light subpath: the state at x_1 ..= x_m (light.rs `vertex`).
     let mut lp = vec![Partial::default(); m + 1];
     // An area light's next-event density enters at x_1 (light.rs).
-    let area = p.light == Emitter::Area;
-    let start = if area { 1.0 } else { direct };
-    let mut st = Partial::light(start, emission, cos_light, p.light == Emitter::Point, f);
+    let (area, point) = (p.light == Emitter::Area, p.light == Emitter::Point);
+    let mut st = Partial::light(
+        if area { 1.0 } else { direct },
+        emission,
+        cos_light,
+        point,
+        f,
+    );
     let mut first: Option<Deferred> = None;
     for (k, state) in lp.iter_mut().enumerate().skip(1) {
         if k >= 2 {
@@ -270,6 +273,15 @@ fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial
         }
         *state = st;
     }
+    lp
+}
+
+/// The light subpath's quantities at x_1 ..= x_m, the camera subpath's at
+/// x_m ..= x_0 and the camera's for its emission weight at x_0, built as
+/// light.rs and camera.rs build them.
+fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial) {
+    let (m, seg) = (p.m(), |k: usize| p.seg[k]);
+    let lp = light_states(p, f);
     // Camera subpath: the state at x_m ..= x_1, then at the light
     // (camera.rs `apply_scatter`, `emission_weight`).
     let mut cp = vec![Partial::default(); m + 1];

@@ -110,6 +110,7 @@
 //! shrinks more slowly than SPPM's 2/3.
 
 mod camera;
+pub mod densities;
 pub mod light;
 mod merge;
 pub mod mis;
