@@ -167,3 +167,43 @@ impl LightSample {
         self.f_cos * self.li * (power_heuristic(1.0, p_l, 1.0, p_bsdf) / p_l)
     }
 }
+
+/// The density with which next-event estimation at `ctx` (the receiver)
+/// samples the point `x0` of area light `id`: the selection probability
+/// times the light's own [`Light::pdf_li`] (a sphere's cone sampling),
+/// taken to area measure at `x0` [Veach 1997, eq. 8.10].
+///
+/// The MIS weights of VCM and BDPT use this density for the next-event
+/// technique of a path that starts at a light whose next-event sampling is
+/// not by area ([`crate::light::Light::samples_li_by_area`]), not the
+/// emission's uniform-area one (module doc of
+/// [`crate::integrator::vcm::mis`], "Next-event density").
+///
+/// [`Light::pdf_li`]: crate::light::Light::pdf_li
+pub fn nee_area_density(
+    scene: &Scene,
+    id: LightId,
+    x0: &Interaction,
+    ctx: &LightSampleContext,
+) -> f32 {
+    let d = x0.p - ctx.p;
+    let d2 = d.length_squared();
+    if d2 <= 0.0 {
+        return 0.0;
+    }
+    let wi = d / d2.sqrt();
+    let pdf = scene.light(id).pdf_li(ctx, wi).0;
+    scene.light_sampler().pmf(id) * pdf * x0.n.dot(wi).abs() / d2
+}
+
+/// The next-event context at vertex `v` (as [`Receiver::at_vertex`] makes it).
+///
+/// [`Receiver::at_vertex`]: crate::integrator::nee::Receiver::at_vertex
+pub fn nee_context(v: &Vertex) -> LightSampleContext {
+    LightSampleContext {
+        p: v.it.p,
+        p_error: v.it.p_error,
+        n: v.it.n,
+        ns: v.ns,
+    }
+}

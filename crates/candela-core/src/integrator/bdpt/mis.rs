@@ -15,10 +15,20 @@
 //!
 //! The densities next to the connection are unknown to either subpath and
 //! are computed here; all others were stored by the random walks.
+//!
+//! **Next-event density.** Strategy k = 1 (next-event estimation at x₁)
+//! draws x₀ with the light sampler's own density p_NEE(x₀ | x₁), which for
+//! a sphere light (cone sampling) is not the emission's uniform-area p_L[0]
+//! that the other strategies use (pbrt-v4 weighs it with p_L[0]). So p_1
+//! carries the factor q = p_NEE/p_L[0] ([`nee_factor`]; 1 for lights
+//! sampled by area): the term of k = 1 is multiplied by q, and when s = 1
+//! every other term is divided by it. The module doc of
+//! [`crate::integrator::vcm::mis`] gives the reason.
 
 use super::density::{pdf, pdf_light_origin, pdf_scatter_pair};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
+use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::integrator::subpath::{Vertex, VertexKind};
 use crate::light::LightType;
 use crate::scene::Scene;
@@ -164,6 +174,36 @@ impl JoinDensities {
     }
 }
 
+/// q = p_NEE(x₀ | x₁) / p_L[0] of a path of `n` vertices (module doc):
+/// the ratio of strategy k = 1's density of x₀ to the emission's `p_l0`; 1
+/// unless x₀ is on an area light sampled by cone and x₁ scatters (n ≥ 3;
+/// at n = 2, k = 1 is light tracing of x₀).
+pub(crate) fn nee_factor(scene: &Scene, x0: &Vertex, x1: &Vertex, n: usize, p_l0: f32) -> f32 {
+    let Some(id) = x0.light_id() else { return 1.0 };
+    let light = scene.light(id);
+    if n < 3 || light.light_type() != LightType::Area || light.samples_li_by_area() || p_l0 <= 0.0 {
+        return 1.0;
+    }
+    let q = nee_area_density(scene, id, &x0.it, &nee_context(x1)) / p_l0;
+    if q > 0.0 && q.is_finite() {
+        q
+    } else {
+        1.0
+    }
+}
+
+/// The term of strategy k in the weight of strategy s, given r = p_k/p_s
+/// without the next-event factor `q` (module doc).
+#[inline(always)]
+fn with_nee(r: f32, k: usize, s: usize, q: f32) -> f32 {
+    let r = if k == 1 { r * q } else { r };
+    if s == 1 {
+        r / q
+    } else {
+        r
+    }
+}
+
 /// Whether x_i of `view` is specular (the connection endpoints never are).
 #[inline]
 fn is_delta(view: &PathView<'_>, i: usize) -> bool {
@@ -181,6 +221,8 @@ pub(crate) struct PathDensities {
     pub p_eye: Vec<f32>,
     /// Whether x_i is specular (the connection endpoints never are).
     pub delta: Vec<bool>,
+    /// q = p_NEE/p_L[0] ([`nee_factor`]).
+    pub nee: f32,
 }
 
 #[cfg(test)]
@@ -189,10 +231,12 @@ impl PathDensities {
     pub fn of(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
         let j = JoinDensities::of(scene, camera, view);
         let n = view.n();
+        let p_l0 = j.p_light(view, 0);
         Self {
             p_light: (0..n).map(|i| j.p_light(view, i)).collect(),
             p_eye: (0..n).map(|i| j.p_eye(view, i)).collect(),
             delta: (0..n).map(|i| is_delta(view, i)).collect(),
+            nee: nee_factor(scene, view.get(0), view.get(1), n, p_l0),
         }
     }
 }
@@ -272,14 +316,14 @@ pub(crate) fn weight_from_densities(
     for k in s + 1..n {
         r *= remap0(d.p_light[k - 1]) / remap0(d.p_eye[k - 1]);
         if strategy_valid(scene, camera, x0, &d.delta, k) {
-            sum += h.apply(r);
+            sum += h.apply(with_nee(r, k, s, d.nee));
         }
     }
     r = 1.0;
     for k in (0..s).rev() {
         r *= remap0(d.p_eye[k]) / remap0(d.p_light[k]);
         if strategy_valid(scene, camera, x0, &d.delta, k) {
-            sum += h.apply(r);
+            sum += h.apply(with_nee(r, k, s, d.nee));
         }
     }
     if !sum.is_finite() {
@@ -302,19 +346,20 @@ pub(crate) fn mis_weight(
     let strategies = Strategies::new(scene, camera, x0, n);
     let valid = |k: usize| strategies.valid(|i| is_delta(view, i), k);
     let remap0 = |p: f32| if p != 0.0 { p } else { 1.0 };
+    let q = nee_factor(scene, x0, view.get(1), n, j.p_light(view, 0));
     let mut sum = 1.0f32;
     let mut r = 1.0f32;
     for k in s + 1..n {
         r *= remap0(j.p_light(view, k - 1)) / remap0(j.p_eye(view, k - 1));
         if valid(k) {
-            sum += h.apply(r);
+            sum += h.apply(with_nee(r, k, s, q));
         }
     }
     r = 1.0;
     for k in (0..s).rev() {
         r *= remap0(j.p_eye(view, k)) / remap0(j.p_light(view, k));
         if valid(k) {
-            sum += h.apply(r);
+            sum += h.apply(with_nee(r, k, s, q));
         }
     }
     if !sum.is_finite() {

@@ -18,7 +18,9 @@ use super::walk::{generate_camera_subpath, generate_light_subpath, WalkSettings}
 use crate::bsdf::TransportMode;
 use crate::build::{build, Overrides, RenderSetup};
 use crate::camera::CameraSample;
+use crate::integrator::nee::nee_context;
 use crate::integrator::subpath::{Vertex, VertexKind};
+use crate::light::LightType;
 use crate::math::{UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::spectrum::SampledWavelengths;
@@ -31,13 +33,20 @@ WorldBegin
 "#;
 
 /// A closed box with diffuse walls, a rough metal and a glass sphere, lit
-/// by an area light, a point light and a spot light.
+/// by an area light, a small sphere light (sampled by cone: its next-event
+/// density is not the emission's, `nee_factor`), a point light and a spot
+/// light.
 const BOX: &str = r#"
 AttributeBegin
   AreaLightSource "diffuse" "rgb L" [4 4 4]
   Material "diffuse" "rgb reflectance" [0.2 0.2 0.2]
   Shape "trianglemesh" "point3 P" [-0.4 1.99 -0.4  0.4 1.99 -0.4  0.4 1.99 0.4  -0.4 1.99 0.4]
     "integer indices" [0 2 1 0 3 2]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [3 3 3]
+  Translate -0.6 1.5 0.4
+  Shape "sphere" "float radius" [0.08]
 AttributeEnd
 LightSource "point" "point3 from" [0.6 1.5 -0.5] "rgb I" [1 1 1]
 LightSource "spot" "point3 from" [-0.8 1.8 -0.8] "point3 to" [0 0 0] "rgb I" [3 3 3] "float coneangle" [40]
@@ -88,6 +97,7 @@ fn brute_densities(rs: &RenderSetup, view: &PathView<'_>) -> PathDensities {
         p_light: vec![0.0; n],
         p_eye: vec![0.0; n],
         delta: vec![false; n],
+        nee: 1.0,
     };
     for i in 0..n {
         d.p_light[i] = if i == 0 {
@@ -110,6 +120,20 @@ fn brute_densities(rs: &RenderSetup, view: &PathView<'_>) -> PathDensities {
         d.delta[i] = x(i).kind == VertexKind::Surface
             && x(i).bsdf.is_some_and(|b| !b.flags().is_non_specular());
     }
+    // Next-event estimation's density of x_0 from x_1, by its definition:
+    // the light's pdf_li from x_1, selection probability, to area measure.
+    if let (Some(id), true) = (x(0).light_id(), n >= 3) {
+        let light = scene.light(id);
+        if light.light_type() == LightType::Area && !light.samples_li_by_area() {
+            let ctx = nee_context(x(1));
+            let d01 = x(0).p() - ctx.p;
+            let wi = d01.normalize();
+            let p_nee =
+                scene.light_sampler().pmf(id) * light.pdf_li(&ctx, wi).0 * x(0).it.n.dot(wi).abs()
+                    / d01.length_squared();
+            d.nee = p_nee / d.p_light[0];
+        }
+    }
     d
 }
 
@@ -118,7 +142,9 @@ fn product_weight(rs: &RenderSetup, x0: &Vertex, d: &PathDensities, s: usize, be
     let n = d.delta.len();
     let remap = |p: f32| if p != 0.0 { p as f64 } else { 1.0 };
     let p = |k: usize| -> f64 {
-        let l: f64 = (0..k).map(|i| remap(d.p_light[i])).product();
+        // Strategy 1 draws x_0 by next-event estimation: p_NEE = q p_L[0].
+        let q = if k == 1 { d.nee as f64 } else { 1.0 };
+        let l: f64 = q * (0..k).map(|i| remap(d.p_light[i])).product::<f64>();
         let e: f64 = (k..n).map(|i| remap(d.p_eye[i])).product();
         (l * e).powi(beta)
     };
@@ -134,6 +160,8 @@ struct Coverage {
     paths_by_length: [usize; 8],
     with_specular: usize,
     with_delta_light: usize,
+    /// Paths from the sphere light whose next-event density differs.
+    with_cone_light: usize,
     max_rel_err: f32,
 }
 
@@ -146,12 +174,14 @@ fn close(a: f32, b: f32) -> f32 {
     }
 }
 
-/// Checks one connected path; records what it covered.
-fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut Coverage) {
-    let n = view.n();
-    let used = PathDensities::of(&rs.scene, &rs.camera, view);
-    let brute = brute_densities(rs, view);
-    for i in 0..n - 1 {
+/// The densities the weight used against the brute force's.
+fn check_densities(
+    used: &PathDensities,
+    brute: &PathDensities,
+    view: &PathView<'_>,
+    cov: &mut Coverage,
+) {
+    for i in 0..view.n() - 1 {
         for (a, b, what) in [
             (used.p_light[i], brute.p_light[i], "p_L"),
             (used.p_eye[i], brute.p_eye[i], "p_E"),
@@ -171,6 +201,24 @@ fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut 
         "specular flags (s={}, t={})",
         view.s, view.t
     );
+    let e = close(used.nee, brute.nee);
+    assert!(
+        e < 2e-3,
+        "p_NEE/p_L[0] {} vs recomputed {}",
+        used.nee,
+        brute.nee
+    );
+    if brute.nee != 1.0 {
+        cov.with_cone_light += 1;
+    }
+}
+
+/// Checks one connected path; records what it covered.
+fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut Coverage) {
+    let n = view.n();
+    let used = PathDensities::of(&rs.scene, &rs.camera, view);
+    let brute = brute_densities(rs, view);
+    check_densities(&used, &brute, view, cov);
     let x0 = view.get(0);
     let sum: f64 = (0..n)
         .filter(|&k| strategy_valid(&rs.scene, &rs.camera, x0, &brute.delta, k))
@@ -329,7 +377,9 @@ fn assert_covered(cov: &Coverage) {
 #[test]
 fn mis_weights_sum_to_one_in_a_closed_box() {
     for h in [MisHeuristic::Power, MisHeuristic::Balance] {
-        assert_covered(&run(BOX, h, 3000));
+        let cov = run(BOX, h, 3000);
+        assert_covered(&cov);
+        assert!(cov.with_cone_light > 20, "{cov:?}");
     }
 }
 
