@@ -370,10 +370,11 @@ impl Light {
         }
     }
 
-    /// True when [`sample_li`](Self::sample_li) picks an area light's point
-    /// with the uniform-area density of its emission sampling (every shape
-    /// but the sphere, whose visible cone is sampled), so that next-event
-    /// estimation's density of a point does not depend on the receiver.
+    /// False only for an area light whose [`sample_li`](Self::sample_li)
+    /// does not pick its point with the uniform-area density of its emission
+    /// sampling (a sphere, whose visible cone is sampled): there next-event
+    /// estimation's density of a point depends on the receiver. True for
+    /// every other light, so callers need not check the light's type.
     pub fn samples_li_by_area(&self) -> bool {
         match self {
             Light::DiffuseArea(l) => l.samples_li_by_area(),

@@ -181,7 +181,7 @@ impl JoinDensities {
 pub(crate) fn nee_factor(scene: &Scene, x0: &Vertex, x1: &Vertex, n: usize, p_l0: f32) -> f32 {
     let Some(id) = x0.light_id() else { return 1.0 };
     let light = scene.light(id);
-    if n < 3 || light.light_type() != LightType::Area || light.samples_li_by_area() || p_l0 <= 0.0 {
+    if n < 3 || light.samples_li_by_area() || p_l0 <= 0.0 {
         return 1.0;
     }
     let q = nee_area_density(scene, id, &x0.it, &nee_context(x1)) / p_l0;

@@ -20,7 +20,6 @@ use crate::build::{build, Overrides, RenderSetup};
 use crate::camera::CameraSample;
 use crate::integrator::nee::nee_context;
 use crate::integrator::subpath::{Vertex, VertexKind};
-use crate::light::LightType;
 use crate::math::{UVec2, Vec2};
 use crate::sampler::{Sampler, SamplerKind};
 use crate::spectrum::SampledWavelengths;
@@ -124,7 +123,7 @@ fn brute_densities(rs: &RenderSetup, view: &PathView<'_>) -> PathDensities {
     // the light's pdf_li from x_1, selection probability, to area measure.
     if let (Some(id), true) = (x(0).light_id(), n >= 3) {
         let light = scene.light(id);
-        if light.light_type() == LightType::Area && !light.samples_li_by_area() {
+        if !light.samples_li_by_area() {
             let ctx = nee_context(x(1));
             let d01 = x(0).p() - ctx.p;
             let wi = d01.normalize();

@@ -19,7 +19,7 @@
 //! with the film's filter weight to a [`FilmTile`], so the camera side
 //! filters exactly as the path tracer does.
 
-use super::densities::{light_densities, nee_area_density, nee_context};
+use super::densities::light_densities;
 use super::light::{LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
 use super::mis::{weight, Deferred, Factors, Partial};
@@ -29,6 +29,7 @@ use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::film::FilmTile;
 use crate::integrator::driver::camera_sample;
 use crate::integrator::gather::{gather, Surfel};
+use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::integrator::nee::{sample_light, Receiver};
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
@@ -37,7 +38,7 @@ use crate::integrator::subpath::{
 use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::interaction::SurfaceInteraction;
-use crate::light::{LightSampleContext, LightType};
+use crate::light::LightSampleContext;
 use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
 use crate::sampling::PathRng;
@@ -294,9 +295,9 @@ impl CameraVisitor<'_, '_> {
         }
         let (direct, emission, _) = light_densities(scene, id, &v.it, v.wo);
         // Next-event estimation at the vertex left would have sampled this
-        // point with its own density (densities.rs, `nee_area_density`).
+        // point with its own density (nee.rs, `nee_area_density`).
         let light = scene.light(id);
-        let direct = if light.light_type() == LightType::Area && !light.samples_li_by_area() {
+        let direct = if !light.samples_li_by_area() {
             nee_area_density(scene, id, &v.it, &self.nee_ctx)
         } else {
             direct
@@ -331,8 +332,8 @@ impl CameraVisitor<'_, '_> {
             return;
         }
         // An area light point's density is the one this sample was drawn
-        // with, per unit area (densities.rs, `nee_area_density`).
-        let direct = if light.light_type() == LightType::Area && !light.samples_li_by_area() {
+        // with, per unit area (nee.rs, `nee_area_density`).
+        let direct = if !light.samples_li_by_area() {
             ls.pmf * ls.pdf.0 * cos_light / (e.p() - v.p()).length_squared()
         } else {
             direct

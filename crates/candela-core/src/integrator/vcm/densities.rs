@@ -3,7 +3,6 @@
 //! receiver ([`crate::integrator::nee::nee_area_density`], shared with
 //! BDPT), and by emission (position × direction).
 
-pub use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::interaction::{Interaction, LightId};
 use crate::light::LightType;
 use crate::math::{Ray, Vec3};

@@ -16,12 +16,13 @@
 //! array, into freshly faulted pages, was a serial memcpy of ~12 MB per
 //! iteration at 128².
 
-use super::densities::{light_densities, nee_area_density, nee_context};
+use super::densities::light_densities;
 use super::mis::{weight, Deferred, DirectMerges, Factors, Partial};
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
 use crate::film::SplatBuffer;
 use crate::integrator::driver::LANES;
+use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
     adjoint_cos, start_light_subpath, walk, Dispersion, Flow, Scatter, Vertex, Visitor, Walk,
@@ -29,7 +30,6 @@ use crate::integrator::subpath::{
 use crate::integrator::RenderContext;
 use crate::interaction::SurfaceInteraction;
 use crate::interaction::{Interaction, LightId};
-use crate::light::LightType;
 use crate::math::{Ray, Vec3};
 use crate::sampling::{hash_u64s, PathRng, StreamRng};
 use crate::spatial::HasPosition;
@@ -325,7 +325,7 @@ impl VcmIntegrator {
         // A sphere light's next-event density depends on the receiver x_1:
         // it enters d_VCM when the walk reaches x_1 (`LightVisitor::vertex`).
         let by_area = scene.light(id).samples_li_by_area();
-        let nee_from = (ty == LightType::Area && !by_area).then_some((id, ls.vertex.it));
+        let nee_from = (!by_area).then_some((id, ls.vertex.it));
         let direct = if nee_from.is_some() { 1.0 } else { direct };
         let mis = Partial::light(direct, emission, cos, ty.is_delta(), f);
         if let (true, Some(buf)) = (self.techniques.light_only, buf.as_deref_mut()) {

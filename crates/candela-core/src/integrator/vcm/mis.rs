@@ -54,7 +54,7 @@
 //! stays unbiased), but they no longer favour each technique where it
 //! samples well. So every weight that involves s = 1 uses
 //! p_NEE(x_0 | x_1) = P(light) · p_ω(x_1 → x_0) · |cos θ_0| / d²
-//! ([`super::densities::nee_area_density`]): the light subpath multiplies it
+//! ([`crate::integrator::nee::nee_area_density`]): the light subpath multiplies it
 //! into d_VCM on reaching x_1 (eq. 31 with the density known only there),
 //! next-event estimation uses the density it sampled with, and the camera
 //! subpath hitting the light evaluates it from the vertex it left. Shapes

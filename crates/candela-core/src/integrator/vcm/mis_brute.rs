@@ -44,7 +44,7 @@ struct Path {
     p_pos: f32,
     /// Light selection × next-event density of x_0 seen from x_1 (area; for
     /// an area light it differs from `p_pos`: cone sampling of a sphere,
-    /// densities.rs `nee_area_density`; else it is `p_pos`, or `p_inf_dir` at
+    /// nee.rs `nee_area_density`; else it is `p_pos`, or `p_inf_dir` at
     /// infinity).
     p_nee: f32,
     /// Emission direction density (solid angle; 1 for an infinite light's
