@@ -296,6 +296,11 @@ fn film_sampler_and_integrator_settings_must_be_in_their_domain() {
                 "Integrator \"vcm\" \"directmerges\" \"never\" needs connections (mode \"vcm\"): \
                  this mode has no other technique for direct light",
             ),
+            opts(
+                "Integrator \"vcm\" \"string ltweights\" \"power\"",
+                "\"string ltweights\"",
+                "Integrator \"vcm\" \"ltweights\" \"power\" is unknown (known: variance, density)",
+            ),
         ],
     );
 }

@@ -460,7 +460,22 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
         mode,
         connections,
         direct_merges: vcm_direct_merges(ck, mode)?,
+        variance_lt: vcm_lt_weights(ck)?,
     })
+}
+
+/// `"string ltweights"`: light tracing weighed by the camera side's
+/// variance (`variance`, the default) or by density alone (`density`)
+/// (`integrator::vcm::variance`).
+fn vcm_lt_weights(ck: &Check<'_>) -> Result<bool, BuildError> {
+    match ck.params.get_string("ltweights", "variance")?.as_str() {
+        "variance" => Ok(true),
+        "density" => Ok(false),
+        other => Err(ck.error(
+            "ltweights",
+            format!("\"{other}\" is unknown (known: variance, density)"),
+        )),
+    }
 }
 
 /// `"string directmerges"`: which merges next to the light exist

@@ -22,12 +22,13 @@
 use super::densities::light_densities;
 use super::light::{LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
-use super::mis::{weight, Deferred, Factors, Partial};
+use super::mis::{weight, CameraDeferred, CameraPartial, Factors, Partial};
 use super::resample::Resampler;
+use super::variance::{ByLength, LtWeights, LENGTHS};
 use super::{Connections, VcmIntegrator};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::film::FilmTile;
-use crate::integrator::driver::camera_sample;
+use crate::integrator::driver::{camera_sample, PixelSample};
 use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::integrator::nee::{sample_light, Receiver};
@@ -39,7 +40,7 @@ use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::interaction::SurfaceInteraction;
 use crate::light::LightSampleContext;
-use crate::math::{Ray, UVec2};
+use crate::math::UVec2;
 use crate::sampler::Sampler;
 use crate::sampling::PathRng;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -60,6 +61,10 @@ pub(super) struct CameraPass<'a> {
     pub time: f32,
     /// The pass index.
     pub pass: u64,
+    /// Light tracing's factors in the weights ([`super::variance`]).
+    pub lt: &'a LtWeights,
+    /// Split each path's estimate by length (the variance pilot).
+    pub record: bool,
 }
 
 impl VcmIntegrator {
@@ -72,6 +77,23 @@ impl VcmIntegrator {
         hi: UVec2,
     ) -> FilmTile {
         let mut tile = ctx.film.tile(lo, hi);
+        self.camera_pixels(ctx, cp, lo, hi, |pixel, cs, l, _| {
+            tile.add_sample(pixel, l, &cp.lambda, cs.filter_weight)
+        });
+        tile
+    }
+
+    /// Walks one camera subpath per pixel in [lo, hi) and hands `sink` the
+    /// pixel, its sample, its estimate and (when `cp.record`) that estimate
+    /// split by path length.
+    pub(super) fn camera_pixels(
+        &self,
+        ctx: &RenderContext<'_>,
+        cp: &CameraPass<'_>,
+        lo: UVec2,
+        hi: UVec2,
+        mut sink: impl FnMut(UVec2, &PixelSample, SampledSpectrum, &ByLength),
+    ) {
         let mut sampler = ctx.sampler.clone();
         let res_x = ctx.film.resolution().x as u64;
         let n_light = self.light_paths(ctx);
@@ -84,12 +106,10 @@ impl VcmIntegrator {
                 };
                 let index = (y as u64 * res_x + x as u64) % n_light.max(1);
                 let path = cp.light.path(index as usize);
-                let ray = cs.ray.at_time(cp.time);
-                let l = self.camera_path(ctx, cp, ray, cs.ray_weight, path, &mut sampler);
-                tile.add_sample(pixel, l, &cp.lambda, cs.filter_weight);
+                let (l, by_length) = self.camera_path(ctx, cp, &cs, path, &mut sampler);
+                sink(pixel, &cs, l, &by_length);
             }
         }
-        tile
     }
 
     /// The estimate of one camera subpath starting along `ray`.
@@ -97,11 +117,11 @@ impl VcmIntegrator {
         &self,
         ctx: &RenderContext<'_>,
         cp: &CameraPass<'_>,
-        ray: Ray,
-        ray_weight: f32,
+        cs: &PixelSample,
         path: &[LightVertex],
         sampler: &mut Sampler,
-    ) -> SampledSpectrum {
+    ) -> (SampledSpectrum, ByLength) {
+        let (ray, ray_weight) = (cs.ray.at_time(cp.time), cs.ray_weight);
         let lens = Vertex::camera(
             Interaction {
                 time: cp.time,
@@ -117,16 +137,18 @@ impl VcmIntegrator {
             ctx,
             cp,
             path,
-            mis: Partial::camera(pdf_pixel, n_light, ctx.camera.is_connectable()),
+            mis: CameraPartial::camera(pdf_pixel, n_light, ctx.camera.is_connectable()),
+            lt_row: cp.lt.row(cs.camera_sample.p_film),
             prev: PrevVertex::of(&lens),
             pending: None,
             arrived_delta: false,
-            last: Deferred::default(),
+            last: CameraDeferred::default(),
             last_after_delta: false,
             specular: true,
             vertices: 0,
             nee_ctx: LightSampleContext::at_point(ray.o),
             l: SampledSpectrum::zero(),
+            by_length: [0.0; LENGTHS + 1],
         };
         let w = Walk {
             mode: TransportMode::Radiance,
@@ -144,7 +166,7 @@ impl VcmIntegrator {
         };
         let mut lambda = cp.lambda;
         walk(ctx.scene, &mut lambda, sampler, &w, start, &mut v);
-        v.l
+        (v.l, v.by_length)
     }
 }
 
@@ -154,7 +176,10 @@ struct CameraVisitor<'a, 'b> {
     ctx: &'a RenderContext<'b>,
     cp: &'a CameraPass<'a>,
     path: &'a [LightVertex],
-    mis: Partial,
+    /// The partials, light tracing's part apart ([`CameraPartial`]).
+    mis: CameraPartial,
+    /// Light tracing's factors mis(c) by path length for this pixel.
+    lt_row: &'a [f32],
     prev: PrevVertex,
     pending: Option<Scatter>,
     /// The scattering that reached the current vertex was a delta (not
@@ -162,7 +187,7 @@ struct CameraVisitor<'a, 'b> {
     arrived_delta: bool,
     /// The terms of a merge at the vertex left last, and whether that
     /// vertex had been reached by a delta scattering.
-    last: Deferred,
+    last: CameraDeferred,
     last_after_delta: bool,
     /// Every scattering so far was a delta.
     specular: bool,
@@ -172,6 +197,8 @@ struct CameraVisitor<'a, 'b> {
     /// sampled a light from (its emission weight, [`nee_area_density`]).
     nee_ctx: LightSampleContext,
     l: SampledSpectrum,
+    /// `l` split by path length, when `cp.record`.
+    by_length: ByLength,
 }
 
 /// Divides a join of two subpaths that both kept only the hero wavelength
@@ -246,9 +273,9 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
             let w = if self.vertices == 0 {
                 1.0
             } else {
-                self.emission_weight(direct, emission)
+                self.emission_weight(direct, emission, self.prev.depth)
             };
-            self.l += e.beta * le * w;
+            self.add(self.prev.depth, e.beta * le * w);
         }
     }
 }
@@ -262,26 +289,38 @@ impl CameraVisitor<'_, '_> {
         let f = &self.cp.f;
         self.last = self
             .mis
-            .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, f, true);
+            .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, f);
         self.last_after_delta = self.arrived_delta;
         self.arrived_delta = s.delta;
     }
 
-    /// The weight of emission found by the camera subpath [eq. 43]: the
-    /// vertex it left last is next to the light, and a merge there counts
-    /// only where it exists.
-    fn emission_weight(&self, direct: f32, emission: f32) -> f32 {
+    /// The camera side's partials on a path of `k` scattering vertices,
+    /// light tracing weighed by its factor there ([`super::variance`]).
+    #[inline]
+    fn partial(&self, k: u32) -> Partial {
+        self.mis.with_lt(LtWeights::at(self.lt_row, k))
+    }
+
+    /// Adds `c`, found on a path of `k` scattering vertices.
+    #[inline]
+    fn add(&mut self, k: u32, c: SampledSpectrum) {
+        self.l += c;
+        if self.cp.record {
+            self.by_length[(k as usize).min(LENGTHS)] += c.average();
+        }
+    }
+
+    /// The weight of emission found by the camera subpath after `k`
+    /// scattering vertices [eq. 43]: the vertex it left last is next to the
+    /// light, and a merge there counts only where it exists.
+    fn emission_weight(&self, direct: f32, emission: f32, k: u32) -> f32 {
         if !self.vcm.techniques.connect {
             return if self.specular { 1.0 } else { 0.0 };
         }
-        let mis = if self.cp.f.merges_at(true, self.last_after_delta) {
-            self.mis
-        } else {
-            Partial {
-                d_vc: self.last.d_vc_without,
-                ..self.mis
-            }
-        };
+        let mut mis = self.partial(k);
+        if !self.cp.f.merges_at(true, self.last_after_delta) {
+            mis.d_vc = self.last.d_vc_without(LtWeights::at(self.lt_row, k));
+        }
         weight(0.0, mis.emission_weight(direct, emission))
     }
 
@@ -305,9 +344,9 @@ impl CameraVisitor<'_, '_> {
         let w = if v.depth == 1 {
             1.0
         } else {
-            self.emission_weight(direct, emission)
+            self.emission_weight(direct, emission, v.depth - 1)
         };
-        self.l += v.beta * le * w;
+        self.add(v.depth - 1, v.beta * le * w);
     }
 
     /// s = 1: a light sample for `v` [eqs. 44–45].
@@ -357,8 +396,10 @@ impl CameraVisitor<'_, '_> {
         let ratio = emission * cos_recv * inv_d2 / direct;
         // A merge at v, next to the light, exists after a specular vertex.
         let merge = self.cp.f.merges_at(true, self.arrived_delta);
-        let w_cam = self.mis.connect_weight(ratio, bsdf_rev, &self.cp.f, merge);
-        self.l += v.beta * ls.unweighted() * weight(w_light, w_cam);
+        let w_cam = self
+            .partial(v.depth)
+            .connect_weight(ratio, bsdf_rev, &self.cp.f, merge);
+        self.add(v.depth, v.beta * ls.unweighted() * weight(w_light, w_cam));
     }
 
     /// Connections to the vertices of the pixel's light subpath [eqs.
@@ -376,7 +417,7 @@ impl CameraVisitor<'_, '_> {
                         continue;
                     };
                     if scene.unoccluded(&lv.it, &v.it) {
-                        self.l += x;
+                        self.add(v.depth + lv.depth, x);
                     }
                 }
             }
@@ -389,7 +430,7 @@ impl CameraVisitor<'_, '_> {
                 }
                 if let Some(((lv, x), inv_p)) = r.pick() {
                     if scene.unoccluded(&lv.it, &v.it) {
-                        self.l += x * inv_p;
+                        self.add(v.depth + lv.depth, x * inv_p);
                     }
                 }
             }
@@ -427,7 +468,9 @@ impl CameraVisitor<'_, '_> {
         // light vertex x_1 its camera-side neighbour is v, not specular.
         let merge_light = f.merges_at(lv.depth == 1, false);
         let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f, merge_light);
-        let w_cam = self.mis.connect_weight(light_dir_a, cam_rev.0, f, true);
+        let w_cam =
+            self.partial(v.depth + lv.depth)
+                .connect_weight(light_dir_a, cam_rev.0, f, true);
         let mw = weight(w_light, w_cam);
         (mw != 0.0).then(|| unfold(c * mw, terminated, lv.terminated))
     }
@@ -447,10 +490,12 @@ impl CameraVisitor<'_, '_> {
             w: v.wo,
         };
         let mut sum = SampledSpectrum::zero();
+        let mut by_length: ByLength = [0.0; LENGTHS + 1];
         grid.for_each_within(v.p(), self.cp.radius, |ph| {
             if ph.depth + v.depth > max_depth + 1 || (ph.depth == 1 && !merge_direct) {
                 return;
             }
+            let k = v.depth + ph.depth - 1;
             let Some(c) = gather(&x, &ph.surfel, r2) else {
                 return;
             };
@@ -465,11 +510,18 @@ impl CameraVisitor<'_, '_> {
                 let (cam_dir, cam_rev) = cb.pdfs_pair(&pair, TransportMode::Radiance);
                 weight(
                     ph.mis.merge_weight(cam_dir.0, f),
-                    self.mis.merge_weight(cam_rev.0, f),
+                    self.partial(k).merge_weight(cam_rev.0, f),
                 )
             };
-            sum += unfold(fv * ph.beta * w, terminated, ph.terminated);
+            let c = unfold(fv * ph.beta * w, terminated, ph.terminated);
+            sum += c;
+            if self.cp.record {
+                by_length[(k as usize).min(LENGTHS)] += (v.beta * c).average() * f.merge_norm;
+            }
         });
         self.l += v.beta * sum * f.merge_norm;
+        for (a, b) in self.by_length.iter_mut().zip(by_length) {
+            *a += b;
+        }
     }
 }

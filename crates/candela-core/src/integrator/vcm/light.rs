@@ -18,6 +18,7 @@
 
 use super::densities::light_densities;
 use super::mis::{weight, Deferred, DirectMerges, Factors, Partial};
+use super::variance::LtWeights;
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
 use crate::film::SplatBuffer;
@@ -233,8 +234,9 @@ type Lane = (Option<SplatBuffer>, Vec<(u64, PathChunk)>);
 
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
-    /// `lambda` and time `time`, splatting their camera connections when
-    /// `splat` (the pilot pass wants only the vertices); `None` if the
+    /// `lambda` and time `time`, splatting their camera connections weighed
+    /// with light tracing's factors `lt` when given (the pilots want only the
+    /// vertices); `None` if the
     /// render was cancelled.
     pub(super) fn light_pass(
         &self,
@@ -243,7 +245,7 @@ impl VcmIntegrator {
         lambda: &SampledWavelengths,
         time: f32,
         f: &Factors,
-        splat: bool,
+        lt: Option<&LtWeights>,
     ) -> Option<LightPaths> {
         let n = self.light_paths(ctx);
         let chunk = CHUNK as u64;
@@ -251,7 +253,7 @@ impl VcmIntegrator {
         let lanes: Vec<Lane> = (0..LANES as u64)
             .into_par_iter()
             .map(|lane| {
-                let mut buf = splat.then(|| self.pools.splats.splats(ctx));
+                let mut buf = lt.is_some().then(|| self.pools.splats.splats(ctx));
                 let mut chunks = Vec::new();
                 for c in (lane..n_chunks).step_by(LANES) {
                     if ctx.cancelled() {
@@ -268,7 +270,7 @@ impl VcmIntegrator {
                             time,
                             f,
                             &mut out.vertices,
-                            buf.as_mut(),
+                            buf.as_mut().zip(lt),
                         );
                         out.ends.push(out.vertices.len() as u32);
                     }
@@ -295,7 +297,8 @@ impl VcmIntegrator {
     }
 
     /// Walks light path `i`, storing its vertices in `out` and splatting its
-    /// camera connections into `buf` (none without one).
+    /// camera connections into `buf` with light tracing's factors (none
+    /// without one).
     #[allow(clippy::too_many_arguments)]
     fn trace_light(
         &self,
@@ -306,8 +309,9 @@ impl VcmIntegrator {
         time: f32,
         f: &Factors,
         out: &mut Vec<LightVertex>,
-        mut buf: Option<&mut SplatBuffer>,
+        buf: Option<(&mut SplatBuffer, &LtWeights)>,
     ) {
+        let (mut buf, lt) = buf.unzip();
         let scene = ctx.scene;
         let mut rng = StreamRng::with_hash(hash_u64s(&[self.settings.seed, pass, i, 0x5643_4d4c]));
         let mut lam = *lambda;
@@ -350,6 +354,7 @@ impl VcmIntegrator {
             first: None,
             out,
             buf,
+            lt,
         };
         walk(scene, &mut lam, &mut rng, &w, ls.start, &mut visitor);
     }
@@ -403,6 +408,8 @@ struct LightVisitor<'a, 'b> {
     out: &'a mut Vec<LightVertex>,
     /// Where camera connections are splatted (`None`: not made).
     buf: Option<&'a mut SplatBuffer>,
+    /// Light tracing's factors in the weights, with `buf`.
+    lt: Option<&'a LtWeights>,
 }
 
 impl Visitor<StreamRng> for LightVisitor<'_, '_> {
@@ -524,8 +531,13 @@ impl LightVisitor<'_, '_> {
             // A merge here exists unless next to the light: the lens is
             // the camera-side neighbour.
             let merge = self.f.merges_at(v.depth == 1, false);
+            // Light tracing's density times its factor c on this path: the
+            // others relative to it divide by mis(c) ([`super::variance`]).
+            let c2 = self
+                .lt
+                .map_or(1.0, |lt| LtWeights::at(lt.row(cs.p_raster), v.depth));
             weight(
-                self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f, merge),
+                self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f, merge) / c2,
                 0.0,
             )
         };

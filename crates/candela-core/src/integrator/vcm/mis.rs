@@ -231,6 +231,35 @@ impl Partial {
         f: &Factors,
         merge_here: bool,
     ) -> Deferred {
+        self.step(delta, pdf_fwd, pdf_rev, cos_out, f, merge_here, 1.0)
+    }
+
+    /// [`Partial::scatter`] without the terms the scattering vertex itself
+    /// adds (its d_VCM and its merge's): the linear part of eqs. 34–36,
+    /// which carries what earlier vertices started ([`CameraPartial`]).
+    pub fn propagate(
+        &mut self,
+        delta: bool,
+        pdf_fwd: f32,
+        pdf_rev: f32,
+        cos_out: f32,
+        f: &Factors,
+    ) -> Deferred {
+        self.step(delta, pdf_fwd, pdf_rev, cos_out, f, false, 0.0)
+    }
+
+    /// Eqs. 34–36 with the vertex's own terms times `source` (1 or 0).
+    #[allow(clippy::too_many_arguments)]
+    fn step(
+        &mut self,
+        delta: bool,
+        pdf_fwd: f32,
+        pdf_rev: f32,
+        cos_out: f32,
+        f: &Factors,
+        merge_here: bool,
+        source: f32,
+    ) -> Deferred {
         if delta {
             self.d_vcm = 0.0;
             self.d_vc *= mis(cos_out);
@@ -247,12 +276,12 @@ impl Partial {
         let g = mis(cos_out / pdf_fwd);
         let rev = mis(pdf_rev);
         let merge = Deferred {
-            vc: g * f.vm,
-            vm: g,
+            vc: source * g * f.vm,
+            vm: source * g,
             d_vc_without: g * (self.d_vc * rev + self.d_vcm),
         };
         *self = Self {
-            d_vcm: mis(1.0 / pdf_fwd),
+            d_vcm: source * mis(1.0 / pdf_fwd),
             d_vc: merge.d_vc_without,
             d_vm: g * (self.d_vm * rev + self.d_vcm * f.vc),
         };
@@ -289,6 +318,86 @@ impl Partial {
     /// [eq. 43; the light side's is 0, eq. 42].
     pub fn emission_weight(&self, direct: f32, emission: f32) -> f32 {
         mis(direct) * self.d_vcm + mis(emission) * self.d_vc
+    }
+}
+
+/// A camera subpath's partials split in two: `lt`, what light tracing's
+/// density started (the camera's d_VCM of eq. 31, N_light/p_pixel) and the
+/// recursion carried on, and `rest`, everything else. Every weight is linear
+/// in the partials, so [`CameraPartial::with_lt`] gives the camera side of a
+/// join whose path weighs light tracing's density by a factor c (the
+/// heuristic's power of it, `c2`): the same recursion with N_light scaled by
+/// c for that path alone (variance-aware weights, [`super::variance`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CameraPartial {
+    /// What light tracing's density started.
+    pub lt: Partial,
+    /// The rest.
+    pub rest: Partial,
+}
+
+/// The two parts of a [`Deferred`] of a [`CameraPartial`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CameraDeferred {
+    /// Of the `lt` part (its merge terms are 0: the merge is not light
+    /// tracing's).
+    pub lt: Deferred,
+    /// Of the rest.
+    pub rest: Deferred,
+}
+
+impl CameraDeferred {
+    /// [`Deferred::hit`] on both parts.
+    pub fn hit(&mut self, cos: f32) {
+        self.lt.hit(cos);
+        self.rest.hit(cos);
+    }
+
+    /// d_VC without the merge's terms, with light tracing weighed by `c2`.
+    pub fn d_vc_without(&self, c2: f32) -> f32 {
+        self.rest.d_vc_without + c2 * self.lt.d_vc_without
+    }
+}
+
+impl CameraPartial {
+    /// [`Partial::camera`], all of it light tracing's.
+    pub fn camera(pdf_pixel: f32, n_light: f32, connectable: bool) -> Self {
+        Self {
+            lt: Partial::camera(pdf_pixel, n_light, connectable),
+            rest: Partial::default(),
+        }
+    }
+
+    /// [`Partial::hit`] on both parts.
+    pub fn hit(&mut self, d2: f32, cos: f32) {
+        self.lt.hit(d2, cos);
+        self.rest.hit(d2, cos);
+    }
+
+    /// [`Partial::scatter`]: the vertex's own terms go to the rest.
+    pub fn scatter(
+        &mut self,
+        delta: bool,
+        pdf_fwd: f32,
+        pdf_rev: f32,
+        cos_out: f32,
+        f: &Factors,
+    ) -> CameraDeferred {
+        CameraDeferred {
+            lt: self.lt.propagate(delta, pdf_fwd, pdf_rev, cos_out, f),
+            rest: self.rest.scatter(delta, pdf_fwd, pdf_rev, cos_out, f, true),
+        }
+    }
+
+    /// The partials of a path whose light-tracing density is weighed by c,
+    /// `c2` = mis(c).
+    #[inline]
+    pub fn with_lt(&self, c2: f32) -> Partial {
+        Partial {
+            d_vcm: self.rest.d_vcm + c2 * self.lt.d_vcm,
+            d_vc: self.rest.d_vc + c2 * self.lt.d_vc,
+            d_vm: self.rest.d_vm + c2 * self.lt.d_vm,
+        }
     }
 }
 

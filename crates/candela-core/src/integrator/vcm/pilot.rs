@@ -89,7 +89,7 @@ pub(super) fn density_radius(
         work: &work,
         ..*ctx
     };
-    let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f, false)?;
+    let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f, None)?;
     // The vertices that merge count: those next to the light only if they
     // all do (module doc of `mis`: by default only behind specular ones).
     let all = vcm.direct_merges() == DirectMerges::Always;

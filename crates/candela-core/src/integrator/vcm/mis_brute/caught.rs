@@ -1,0 +1,121 @@
+//! The brute-force check can fail: densities or factors given to the
+//! recursion that are not the path's are caught ([`super`]).
+
+use super::{brute_force, compare, paths, Path, Technique, DIRECT};
+use super::{DirectMerges, Emitter};
+
+/// The check can fail: a density given to the recursion that is not the
+/// path's (x_2's camera-side direction density, that of x_1, 30 % high) is
+/// caught by the main test's criterion on every path of 2+ segments
+/// without specular vertices in which the techniques that use it (the
+/// camera subpath making x_1: s ≤ 1, a merge at x_1) carry more than 1e-6
+/// of the weight; without merges next to the light they can carry less
+/// than 1e-9, below any tolerance.
+#[test]
+fn a_perturbed_density_is_caught() {
+    for direct in DIRECT {
+        let (mut caught, mut tried) = (0, 0);
+        for p in paths().take(600) {
+            if p.m() < 2 || p.delta[1..].iter().any(|&d| d) {
+                continue;
+            }
+            let brute = brute_force(&p, direct);
+            let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
+            let uses_it =
+                |t: &Technique| matches!(t, Technique::Connect(0 | 1) | Technique::Merge(1));
+            let share: f64 = brute
+                .iter()
+                .filter(|(t, _)| uses_it(t))
+                .map(|(_, q)| q * q / total)
+                .sum();
+            if share < 1e-6 {
+                continue;
+            }
+            let mut given = p.clone();
+            given.pe_dir[2] *= 1.3;
+            let Some(m) = compare(&p, &given, direct) else {
+                continue;
+            };
+            tried += 1;
+            caught += !m.agrees() as u32;
+        }
+        assert!(
+            tried > 50 && caught == tried,
+            "{direct:?}: {caught}/{tried}"
+        );
+    }
+}
+
+/// An area light's next-event density is its own technique's: giving the
+/// recursion the emission's position density instead (the weights before
+/// `nee_area_density`, right only for area-uniform sampling) is caught on
+/// every area-light path without specular vertices where next-event
+/// estimation or a hit on the light carries more than 1e-3 of the weight
+/// and the two densities differ by more than 20 %.
+#[test]
+fn the_next_event_density_is_the_samplers() {
+    let (mut caught, mut tried) = (0, 0);
+    for p in paths().take(1200) {
+        let differ = (p.p_nee / p.p_pos - 1.0).abs() > 0.2;
+        if p.light != Emitter::Area || !differ || p.delta[1..].iter().any(|&d| d) {
+            continue;
+        }
+        let direct = DirectMerges::AfterSpecular;
+        let brute = brute_force(&p, direct);
+        let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
+        let share: f64 = brute
+            .iter()
+            .filter(|(t, _)| matches!(t, Technique::Connect(0 | 1)))
+            .map(|(_, q)| q * q / total)
+            .sum();
+        if share < 1e-3 {
+            continue;
+        }
+        let given = Path {
+            p_nee: p.p_pos,
+            ..p.clone()
+        };
+        let Some(m) = compare(&p, &given, direct) else {
+            continue;
+        };
+        tried += 1;
+        caught += !m.agrees() as u32;
+    }
+    assert!(tried > 50 && caught == tried, "{caught}/{tried}");
+}
+
+/// Light tracing's variance factor is in every weight: giving the recursion
+/// c = 1 (density alone) where the path's is below 0.8 is caught on every
+/// path without specular vertices where light tracing carries more than
+/// 1e-3 of the weight.
+#[test]
+fn the_light_tracing_factor_is_applied() {
+    let (mut caught, mut tried) = (0, 0);
+    for p in paths().take(1200) {
+        if p.lt_c > 0.8 || p.delta[1..].iter().any(|&d| d) {
+            continue;
+        }
+        let direct = DirectMerges::AfterSpecular;
+        let brute = brute_force(&p, direct);
+        let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
+        let lt = Technique::Connect(p.m() + 1);
+        let share: f64 = brute
+            .iter()
+            .filter(|(t, _)| *t == lt)
+            .map(|(_, q)| q * q / total)
+            .sum();
+        if share < 1e-3 {
+            continue;
+        }
+        let given = Path {
+            lt_c: 1.0,
+            ..p.clone()
+        };
+        let Some(m) = compare(&p, &given, direct) else {
+            continue;
+        };
+        tried += 1;
+        caught += !m.agrees() as u32;
+    }
+    assert!(tried > 50 && caught == tried, "{caught}/{tried}");
+}
