@@ -27,7 +27,6 @@ use super::resample::Resampler;
 use super::variance::{ByLength, LtWeights, LENGTHS};
 use super::{Connections, VcmIntegrator};
 use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
-use crate::film::FilmTile;
 use crate::integrator::driver::{camera_sample, PixelSample};
 use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::nee::{nee_area_density, nee_context};
@@ -68,21 +67,6 @@ pub(super) struct CameraPass<'a> {
 }
 
 impl VcmIntegrator {
-    /// Renders the camera subpaths of the pixels in [lo, hi) into a tile.
-    pub(super) fn camera_tile(
-        &self,
-        ctx: &RenderContext<'_>,
-        cp: &CameraPass<'_>,
-        lo: UVec2,
-        hi: UVec2,
-    ) -> FilmTile {
-        let mut tile = ctx.film.tile(lo, hi);
-        self.camera_pixels(ctx, cp, lo, hi, |pixel, cs, l, _| {
-            tile.add_sample(pixel, l, &cp.lambda, cs.filter_weight)
-        });
-        tile
-    }
-
     /// Walks one camera subpath per pixel in [lo, hi) and hands `sink` the
     /// pixel, its sample, its estimate and (when `cp.record`) that estimate
     /// split by path length.

@@ -531,15 +531,18 @@ impl LightVisitor<'_, '_> {
             // A merge here exists unless next to the light: the lens is
             // the camera-side neighbour.
             let merge = self.f.merges_at(v.depth == 1, false);
-            // Light tracing's density times its factor c on this path: the
-            // others relative to it divide by mis(c) ([`super::variance`]).
-            let c2 = self
+            // Light tracing's term times its factor c on this path: the
+            // others relative to it divide by c ([`super::variance`]); as
+            // c → 0 it keeps the paths no other technique makes.
+            let c = self
                 .lt
                 .map_or(1.0, |lt| LtWeights::at(lt.row(cs.p_raster), v.depth));
-            weight(
-                self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f, merge) / c2,
-                0.0,
-            )
+            let w_light = self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f, merge);
+            if w_light == 0.0 {
+                1.0
+            } else {
+                weight(w_light / c, 0.0)
+            }
         };
         if w == 0.0 || !ctx.scene.unoccluded(&v.it, &cs.p_lens) {
             return;

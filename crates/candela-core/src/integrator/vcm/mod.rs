@@ -134,6 +134,7 @@
 
 mod camera;
 pub mod densities;
+mod iteration;
 pub mod light;
 mod merge;
 pub mod mis;
@@ -145,16 +146,14 @@ pub mod variance;
 
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
-use crate::integrator::driver::for_each_tile;
-use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::sppm::ppm_radius2;
+use crate::math::UVec2;
 use crate::sampling::hash_u64s;
 use crate::sampling::PdfSolidAngle;
-use camera::CameraPass;
 use light::LightVertex;
-use mis::{DirectMerges, Factors};
+use mis::DirectMerges;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 use variance::LtWeights;
 
 /// Memory of one stored light vertex in bytes (position, normals, BSDF,
@@ -327,7 +326,12 @@ pub struct VcmIntegrator {
     radius0: OnceLock<f32>,
     /// Light tracing's factors in the weights once known ([`variance`]).
     lt_weights: OnceLock<LtWeights>,
+    /// The camera side's estimates of the pilot passes rendered so far.
+    pilot_samples: Mutex<PilotSamples>,
 }
+
+/// Per pilot pass, every pixel's camera-side estimate by path length.
+type PilotSamples = [Option<Vec<(UVec2, variance::ByLength)>>; variance::PILOT_PASSES as usize];
 
 /// The buffers a pass hands to the next ([`light::Pool`]).
 #[derive(Default)]
@@ -347,6 +351,7 @@ impl VcmIntegrator {
             pools: Pools::default(),
             radius0: OnceLock::new(),
             lt_weights: OnceLock::new(),
+            pilot_samples: Mutex::new([None, None]),
         }
     }
 
@@ -362,24 +367,6 @@ impl VcmIntegrator {
             self.settings.radius
         };
         Some(*self.radius0.get_or_init(|| r))
-    }
-
-    /// Light tracing's factors in the weights: the variance pilot's
-    /// ([`variance`]) where light tracing is one of several techniques and
-    /// `ltweights` is `variance`, else 1; `None` if cancelled.
-    fn lt_weights(&self, ctx: &RenderContext<'_>) -> Option<&LtWeights> {
-        if let Some(w) = self.lt_weights.get() {
-            return Some(w);
-        }
-        let t = self.techniques;
-        let pilot =
-            self.settings.variance_lt && t.connect && !t.light_only && ctx.camera.is_connectable();
-        let w = if pilot {
-            self.lt_weights_pilot(ctx, self.radius(0))?
-        } else {
-            LtWeights::uniform(1.0)
-        };
-        Some(self.lt_weights.get_or_init(|| w))
     }
 
     /// Which merges at a vertex next to the light are a technique: the
@@ -460,56 +447,30 @@ impl Integrator for VcmIntegrator {
         _state: &mut IntegratorState,
         block: &mut PassBlock,
     ) -> PassOutcome {
-        let t = self.techniques;
         if self.radius0(ctx).is_none() {
             return PassOutcome::Cancelled;
         }
-        let Some(lt) = self.lt_weights(ctx) else {
+        // The first passes are the variance pilot's ([`variance`]).
+        let (lt, record) = if self.variance_pilot(ctx) && pass < variance::PILOT_PASSES {
+            (&*variance::NO_LT, self.lt_weights.get().is_none())
+        } else {
+            match self.lt_weights(ctx) {
+                Some(lt) => (lt, false),
+                None => return PassOutcome::Cancelled,
+            }
+        };
+        let Some(it) = self.iteration(ctx, pass, lt, record) else {
             return PassOutcome::Cancelled;
         };
-        let radius = self.radius(pass);
-        let n_light = self.light_paths(ctx) as f32;
-        let f = Factors::new(radius, n_light, t.connect, t.merge, self.direct_merges());
-        // One wavelength group: every light and camera path of the iteration
-        // shares its wavelengths, so merged power stays spectral.
-        let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);
-        let time = self.time(ctx, pass);
-        let Some(mut light) = self.light_pass(ctx, pass, &lambda, time, &f, Some(lt)) else {
-            return PassOutcome::Cancelled;
-        };
-        self.stored.store(light.len() as u64, Ordering::Relaxed);
-        for b in &light.splats {
+        for b in &it.splats {
             block.add_splats(b);
         }
-        self.pools.splats.give(std::mem::take(&mut light.splats));
-        if t.light_only {
-            light.recycle(&self.pools.chunks);
-            return PassOutcome::Done;
-        }
-        let grid = (t.merge && !light.is_empty() && radius > 0.0)
-            .then(|| merge::MergeGrid::build(&light, radius));
-        let cp = CameraPass {
-            light: &light,
-            grid: grid.as_ref(),
-            radius,
-            f,
-            lambda,
-            time,
-            pass,
-            lt,
-            record: false,
-        };
-        let tiles = for_each_tile(ctx, |lo, hi| {
-            let tile = self.camera_tile(ctx, &cp, lo, hi);
-            ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
-            tile
-        });
-        light.recycle(&self.pools.chunks);
-        let Some(tiles) = tiles else {
-            return PassOutcome::Cancelled;
-        };
-        for tile in &tiles {
+        self.pools.splats.give(it.splats);
+        for tile in &it.tiles {
             block.add_tile(tile);
+        }
+        if let Some(samples) = it.samples {
+            self.keep_pilot_samples(ctx, pass, samples);
         }
         PassOutcome::Done
     }

@@ -37,11 +37,10 @@
 //! unchanged (the camera sees its floor only through the water, where light
 //! tracing cannot reach the lens).
 //!
-//! **The pilot.** Before the first pass, two iterations run without light
-//! tracing (c = 0: the camera's techniques alone are then a complete
-//! estimator) at pass indices of their own, so every process of a
-//! `--pass-range` render computes the same factors and passes stay
-//! independent. Each gives every pixel, per path length k, a sample x of the
+//! **The pilot.** Passes 0 and 1 are rendered with c = 0: light tracing
+//! keeps only the paths no other technique makes (the limit c → 0 of its
+//! weight), and the camera's techniques alone estimate the rest. Each of
+//! the two passes gives every pixel, per path length k, a sample x of the
 //! camera side's estimate (mean over the iteration's wavelengths). With the
 //! two samples x₁, x₂ of each pixel, (x₁ − x₂)²/2 estimates the pixel's
 //! variance V and (x₁² + x₂²)/2 its second moment M without bias, so over
@@ -51,18 +50,19 @@
 //! diffuse wall: c ≈ 0.1 on the Cornell box's), near 1 where a few samples
 //! carry it (caustics, which the camera finds by chance). A block or length
 //! with nothing keeps c = 1, and c stays at least [`C_MIN`]: a pilot that
-//! missed a rare effect must not switch light tracing off for it. The pilot
-//! costs two iterations once per render.
+//! missed a rare effect must not switch light tracing off for it.
+//!
+//! Passes from 2 on use the factors. A process that did not render passes
+//! 0 and 1 (`--pass-range 8..16`, `--resume`) computes their camera side
+//! again, by the same code ([`super::iteration`]), without adding it to the
+//! image: every process finds the same factors, passes stay independent,
+//! and a single render pays nothing for the pilot.
 
-use super::camera::CameraPass;
-use super::merge::MergeGrid;
-use super::mis::Factors;
 use super::VcmIntegrator;
-use crate::integrator::driver::for_each_tile;
-use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::RenderContext;
 use crate::math::{UVec2, Vec2};
 use std::sync::atomic::AtomicU64;
+use std::sync::LazyLock;
 
 /// Side of an image block, in pixels.
 pub const BLOCK: u32 = 8;
@@ -73,9 +73,12 @@ pub const LENGTHS: usize = 8;
 /// Smallest factor c (module doc).
 pub const C_MIN: f32 = 1.0 / 32.0;
 
-/// The variance pilot's pass index: no rendered pass, nor the radius
-/// pilot, has it.
-const PILOT_PASS: u64 = u64::MAX - 1;
+/// The passes whose camera side's estimates set the factors (module doc).
+pub const PILOT_PASSES: u64 = 2;
+
+/// The factors of the pilot passes: light tracing weighed only where it is
+/// the only technique (c → 0).
+pub static NO_LT: LazyLock<LtWeights> = LazyLock::new(|| LtWeights::uniform(0.0));
 
 /// A camera path's estimate split by path length (scattering vertices
 /// 1..=[`LENGTHS`], the last holding all longer ones), mean over
@@ -123,6 +126,15 @@ impl LtWeights {
         row[(k as usize - 1).min(LENGTHS - 1)]
     }
 
+    /// The factors from the two pilot passes' estimates, in the same pixel
+    /// order.
+    pub fn from_pilot(resolution: UVec2, a: &[(UVec2, ByLength)], b: &[(UVec2, ByLength)]) -> Self {
+        Self::from_samples(
+            resolution,
+            a.iter().zip(b).map(|((p, x1), (_, x2))| (*p, x1, x2)),
+        )
+    }
+
     /// The factors from the pilot's two samples per pixel (module doc):
     /// `samples` yields (pixel, x per length of the first, of the second).
     pub fn from_samples<'a>(
@@ -167,60 +179,63 @@ fn variance_factor(s: &[f64; 2]) -> f32 {
 }
 
 impl VcmIntegrator {
-    /// Runs the pilot (module doc) with merge radius `radius`; `None` if
-    /// the render was cancelled.
-    pub(super) fn lt_weights_pilot(
-        &self,
-        ctx: &RenderContext<'_>,
-        radius: f32,
-    ) -> Option<LtWeights> {
-        let first = self.pilot_iteration(ctx, radius, PILOT_PASS)?;
-        let second = self.pilot_iteration(ctx, radius, PILOT_PASS - 1)?;
-        let samples = first.iter().zip(&second).map(|((p, a), (_, b))| (*p, a, b));
-        Some(LtWeights::from_samples(ctx.film.resolution(), samples))
+    /// Whether light tracing's factors come from the pilot: `ltweights
+    /// variance`, and light tracing is one of several techniques.
+    pub(super) fn variance_pilot(&self, ctx: &RenderContext<'_>) -> bool {
+        let t = self.techniques;
+        self.settings.variance_lt && t.connect && !t.light_only && ctx.camera.is_connectable()
     }
 
-    /// One iteration without light tracing at pass index `pass`: every
-    /// pixel's estimate split by path length, in a fixed pixel order.
-    fn pilot_iteration(
+    /// Keeps the camera side's estimates of rendered pilot pass `pass`,
+    /// and sets the factors once both are there.
+    pub(super) fn keep_pilot_samples(
         &self,
         ctx: &RenderContext<'_>,
-        radius: f32,
         pass: u64,
-    ) -> Option<Vec<(UVec2, ByLength)>> {
-        let t = self.techniques;
-        let n_light = self.light_paths(ctx) as f32;
-        let f = Factors::new(radius, n_light, t.connect, t.merge, self.direct_merges());
-        let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);
-        let time = self.time(ctx, pass);
+        samples: Vec<(UVec2, ByLength)>,
+    ) {
+        let Ok(mut kept) = self.pilot_samples.lock() else {
+            return;
+        };
+        kept[pass as usize] = Some(samples);
+        if let [Some(a), Some(b)] = &*kept {
+            let w = LtWeights::from_pilot(ctx.film.resolution(), a, b);
+            self.lt_weights.get_or_init(|| w);
+            *kept = [None, None];
+        }
+    }
+
+    /// Light tracing's factors in the weights (module doc): from the pilot
+    /// passes' estimates, those this process did not render computed now
+    /// (not added to the image); 1 everywhere without the pilot. `None` if
+    /// cancelled.
+    pub(super) fn lt_weights(&self, ctx: &RenderContext<'_>) -> Option<&LtWeights> {
+        if let Some(w) = self.lt_weights.get() {
+            return Some(w);
+        }
+        if !self.variance_pilot(ctx) {
+            return Some(self.lt_weights.get_or_init(|| LtWeights::uniform(1.0)));
+        }
+        let mut kept = self.pilot_samples.lock().ok()?;
         // Its own work counter: the pass's progress counts rendered paths only.
         let work = AtomicU64::new(0);
         let pilot = RenderContext {
             work: &work,
             ..*ctx
         };
-        let light = self.light_pass(&pilot, pass, &lambda, time, &f, None)?;
-        let grid = (t.merge && !light.is_empty() && radius > 0.0)
-            .then(|| MergeGrid::build(&light, radius));
-        let off = LtWeights::uniform(0.0);
-        let cp = CameraPass {
-            light: &light,
-            grid: grid.as_ref(),
-            radius,
-            f,
-            lambda,
-            time,
-            pass,
-            lt: &off,
-            record: true,
+        for (pass, slot) in kept.iter_mut().enumerate() {
+            if slot.is_none() {
+                let it = self.iteration(&pilot, pass as u64, &NO_LT, true)?;
+                self.pools.splats.give(it.splats);
+                *slot = it.samples;
+            }
+        }
+        let [Some(a), Some(b)] = &*kept else {
+            return None;
         };
-        let tiles = for_each_tile(&pilot, |lo, hi| {
-            let mut out = Vec::with_capacity(((hi.x - lo.x) * (hi.y - lo.y)) as usize);
-            self.camera_pixels(&pilot, &cp, lo, hi, |pixel, _, _, x| out.push((pixel, *x)));
-            out
-        });
-        light.recycle(&self.pools.chunks);
-        Some(tiles?.into_iter().flatten().collect())
+        let w = LtWeights::from_pilot(ctx.film.resolution(), a, b);
+        *kept = [None, None];
+        Some(self.lt_weights.get_or_init(|| w))
     }
 }
 
