@@ -89,7 +89,7 @@
 //!
 //! **Default radius**: without a written `radius`, the first pass runs a
 //! pilot light pass and takes the radius whose disk holds three other
-//! merging light vertices around the median one, within ½–6 pixel
+//! merging light vertices around the median one, within 2–6 pixel
 //! footprints ([`pilot`]). A merge's noise is set by the vertices in its
 //! disk and its kernel bias by the radius, and the vertex density per
 //! pixel footprint differs twentyfold between these scenes. Measured at
