@@ -10,7 +10,10 @@ rendered once and cached under target/vcm-bench/ (by scene, scale,
 reference integrator and its time; `--ref SCENE=FILE.exr` supplies one),
 then every integrator renders the scene with `--time-limit` t for a
 geometric series t0, 2 t0, ..., and `candela diff` gives its relMSE against
-the reference (eps 0.01, the whole image). Every integrator renders the
+the reference (eps 0.01, the whole image). Wall time on a shared machine
+drifts by ±20 % over minutes, so `--reps N` renders every point N times
+(seeds differ), interleaving the integrators at each time limit, and the
+tables hold the medians. Every integrator renders the
 scene file's own Integrator parameters (maxdepth) through `--integrator`,
 with its defaults otherwise (the photon integrators' scene-derived radius;
 one light path per pixel per iteration): no per-integrator tuning.
@@ -23,7 +26,8 @@ is L S D S E).
 
 Output (in --out, default target/vcm-bench/): results.md (a markdown table:
 error, passes and light paths/s per scene, integrator and time; the stored
-light vertex's size in bytes and the vertices stored per vcm iteration), and
+light vertex's size in bytes and the vertices stored per vcm iteration; vcm's
+ratio to the best other integrator at every time limit), and
 error_vs_time.png, log-log plots of relMSE and MAE against render time per
 scene (relMSE is dominated by rare bright paths; MAE shows the bulk).
 The plot needs matplotlib; when the running Python has none, the script
@@ -122,56 +126,76 @@ def reference(name, scene, a, outdir):
 
 
 def bench_scene(name, a, outdir, rows, vertex_info):
+    """Renders every (integrator, time limit) `--reps` times, interleaved:
+    each repetition walks the time limits and, at each, every integrator in
+    turn, so a slow spell of the machine falls on neighbours alike; rows
+    get the median of each figure over the repetitions."""
     scene, temporary = scaled_scene(SCENES[name], a.scale)
     try:
         ref = reference(name, scene, a, outdir)
         pixels = film_pixels(scene)
+        runs = {}
+        for r in range(a.reps):
+            for k in range(a.steps):
+                t = a.t0 * 2 ** k
+                for integ in a.integrators:
+                    img = os.path.join(outdir, f"{name}-x{a.scale}-{integ}-{t:g}s-r{r}.exr")
+                    passes, secs, status = render(scene, integ, t, img, a.threads, 1 + k + 100 * r)
+                    err, mae = errors(img, ref)
+                    lps = passes * pixels * LIGHT_PATHS_PER_PIXEL.get(integ, 0) / secs if secs > 0 else 0
+                    runs.setdefault((integ, t), []).append((passes, secs, err, lps, mae))
+                    print(f"{name:14} {integ:5} t={t:<6g} rep {r} passes {passes:6} render {secs:7.2f} s "
+                          f"relMSE {err:.5g} MAE {mae:.4g} light paths/s {lps:.3g}", flush=True)
+                    v = re.search(r"(\d+) light vertices stored × (\d+) B(?: \(\+ (\d+) B to merge\))?",
+                                  status)
+                    if integ == "vcm" and v:
+                        size = int(v.group(2)) + int(v.group(3) or 0)
+                        vertex_info[name] = (int(v.group(1)), size, pixels)
         for integ in a.integrators:
             for k in range(a.steps):
                 t = a.t0 * 2 ** k
-                img = os.path.join(outdir, f"{name}-x{a.scale}-{integ}-{t:g}s.exr")
-                passes, secs, status = render(scene, integ, t, img, a.threads, 1 + k)
-                err, mae = errors(img, ref)
-                lps = passes * pixels * LIGHT_PATHS_PER_PIXEL.get(integ, 0) / secs if secs > 0 else 0
+                med = [median([run[i] for run in runs[(integ, t)]]) for i in range(5)]
+                passes, secs, err, lps, mae = med
                 rows.append((name, integ, t, passes, secs, err, lps, mae))
-                print(f"{name:14} {integ:5} t={t:<6g} passes {passes:6} render {secs:7.2f} s "
-                      f"relMSE {err:.5g} MAE {mae:.4g} light paths/s {lps:.3g}", flush=True)
-                v = re.search(r"(\d+) light vertices stored × (\d+) B(?: \(\+ (\d+) B to merge\))?",
-                              status)
-                if integ == "vcm" and v:
-                    size = int(v.group(2)) + int(v.group(3) or 0)
-                    vertex_info[name] = (int(v.group(1)), size, pixels)
     finally:
         if temporary:
             os.unlink(scene)
+
+
+def median(xs):
+    xs = sorted(xs)
+    n = len(xs)
+    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
 
 
 def table(rows, vertex_info, a):
     given = ", ".join(a.ref)
     reference = (f"references given: {given}; otherwise {a.ref_integrator} {a.ref_seconds:g} s" if given
                  else f"reference {a.ref_integrator} {a.ref_seconds:g} s")
-    lines = [f"# Equal-time relMSE (scale {a.scale}, {reference}"
+    lines = [f"# Equal-time relMSE (scale {a.scale}, {reference}, medians of {a.reps} interleaved run(s)"
              f"{', QUICK: not the real bench' if a.quick else ''})", "",
              "| scene | integrator | time limit s | passes | render s | relMSE | MAE | light paths/s |",
              "|---|---|---|---|---|---|---|---|"]
     for name, integ, t, passes, secs, err, lps, mae in rows:
         lp = f"{lps:.3g}" if lps else "-"
-        lines.append(f"| {name} | {integ} | {t:g} | {passes} | {secs:.2f} | {err:.4g} | {mae:.4g} | {lp} |")
+        lines.append(f"| {name} | {integ} | {t:g} | {passes:g} | {secs:.2f} | {err:.4g} | {mae:.4g} | {lp} |")
     lines += ["", "## vcm: stored light vertices (last iteration of the longest run)", "",
               "| scene | light paths / iteration | vertices stored | bytes / vertex | MB / iteration |",
               "|---|---|---|---|---|"]
     for name, (n, size, pixels) in vertex_info.items():
         lines.append(f"| {name} | {pixels} | {n} | {size} | {n * size / 1e6:.2f} |")
-    lines += ["", "## vcm against the best other integrator at the longest time limit", "",
-              "| scene | vcm relMSE | best other | its relMSE | ratio (target <= 1.2; < 1 on pool) |",
-              "|---|---|---|---|---|"]
-    tmax = a.t0 * 2 ** (a.steps - 1)
+    lines += ["", "## vcm against the best other integrator at every time limit", "",
+              "| scene | time limit s | vcm relMSE | best other | its relMSE | ratio (target <= 1.2; < 1 on pool) |",
+              "|---|---|---|---|---|---|"]
     for name in a.scenes:
-        at = {r[1]: r[5] for r in rows if r[0] == name and r[2] == tmax}
-        if "vcm" not in at or len(at) < 2:
-            continue
-        best = min((e, i) for i, e in at.items() if i != "vcm")
-        lines.append(f"| {name} | {at['vcm']:.4g} | {best[1]} | {best[0]:.4g} | {at['vcm'] / best[0]:.3g} |")
+        for k in range(a.steps):
+            t = a.t0 * 2 ** k
+            at = {r[1]: r[5] for r in rows if r[0] == name and r[2] == t}
+            if "vcm" not in at or len(at) < 2:
+                continue
+            best = min((e, i) for i, e in at.items() if i != "vcm")
+            lines.append(f"| {name} | {t:g} | {at['vcm']:.4g} | {best[1]} | {best[0]:.4g} | "
+                         f"{at['vcm'] / best[0]:.3g} |")
     return "\n".join(lines) + "\n"
 
 
@@ -227,6 +251,8 @@ def main():
     ap.add_argument("--integrators", nargs="+", default=INTEGRATORS)
     ap.add_argument("--t0", type=float, default=4.0, help="shortest time limit, seconds")
     ap.add_argument("--steps", type=int, default=6, help="time limits t0 * 2^k, k < steps")
+    ap.add_argument("--reps", type=int, default=1,
+                    help="repetitions, interleaved; the table holds medians (the machine's speed drifts)")
     ap.add_argument("--ref-seconds", type=float, default=3600.0)
     ap.add_argument("--ref-integrator", default="vcm")
     ap.add_argument("--ref", action="append", default=[], metavar="SCENE=EXR",
