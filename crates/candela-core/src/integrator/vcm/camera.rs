@@ -96,7 +96,8 @@ impl VcmIntegrator {
         }
     }
 
-    /// The estimate of one camera subpath starting along `ray`.
+    /// The estimate of one camera subpath from pixel sample `cs`, and that
+    /// estimate split by path length when `cp.record`.
     fn camera_path(
         &self,
         ctx: &RenderContext<'_>,
@@ -162,7 +163,7 @@ struct CameraVisitor<'a, 'b> {
     path: &'a [LightVertex],
     /// The partials, light tracing's part apart ([`CameraPartial`]).
     mis: CameraPartial,
-    /// Light tracing's factors mis(c) by path length for this pixel.
+    /// Light tracing's factors c by path length for this pixel.
     lt_row: &'a [f32],
     prev: PrevVertex,
     pending: Option<Scatter>,

@@ -322,12 +322,12 @@ impl Partial {
 }
 
 /// A camera subpath's partials split in two: `lt`, what light tracing's
-/// density started (the camera's d_VCM of eq. 31, N_light/p_pixel) and the
-/// recursion carried on, and `rest`, everything else. Every weight is linear
-/// in the partials, so [`CameraPartial::with_lt`] gives the camera side of a
-/// join whose path weighs light tracing's density by a factor c (the
-/// heuristic's power of it, `c2`): the same recursion with N_light scaled by
-/// c for that path alone (variance-aware weights, [`super::variance`]).
+/// density started (the camera's d_VCM of eq. 31, mis(N_light/p_pixel)) and
+/// the recursion carried on, and `rest`, everything else. Every weight is
+/// linear in the partials, so [`CameraPartial::with_lt`] gives the camera
+/// side of a join whose path multiplies light tracing's term by a factor c:
+/// the same recursion with that term scaled by c for that path alone
+/// (variance-aware weights, [`super::variance`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CameraPartial {
     /// What light tracing's density started.
@@ -353,9 +353,9 @@ impl CameraDeferred {
         self.rest.hit(cos);
     }
 
-    /// d_VC without the merge's terms, with light tracing weighed by `c2`.
-    pub fn d_vc_without(&self, c2: f32) -> f32 {
-        self.rest.d_vc_without + c2 * self.lt.d_vc_without
+    /// d_VC without the merge's terms, light tracing's term times `c`.
+    pub fn d_vc_without(&self, c: f32) -> f32 {
+        self.rest.d_vc_without + c * self.lt.d_vc_without
     }
 }
 
@@ -389,14 +389,15 @@ impl CameraPartial {
         }
     }
 
-    /// The partials of a path whose light-tracing density is weighed by c,
-    /// `c2` = mis(c).
+    /// The partials of a path whose light-tracing term is multiplied by `c`
+    /// (the term is already raised to the heuristic's power, as every
+    /// partial is; c multiplies it, not the density).
     #[inline]
-    pub fn with_lt(&self, c2: f32) -> Partial {
+    pub fn with_lt(&self, c: f32) -> Partial {
         Partial {
-            d_vcm: self.rest.d_vcm + c2 * self.lt.d_vcm,
-            d_vc: self.rest.d_vc + c2 * self.lt.d_vc,
-            d_vm: self.rest.d_vm + c2 * self.lt.d_vm,
+            d_vcm: self.rest.d_vcm + c * self.lt.d_vcm,
+            d_vc: self.rest.d_vc + c * self.lt.d_vc,
+            d_vm: self.rest.d_vm + c * self.lt.d_vm,
         }
     }
 }
