@@ -331,6 +331,11 @@ fn memory_hungry_settings_are_refused_before_allocating_even_by_info() {
                 "\"integer photons\"",
                 "Integrator \"photonmap\" \"photons\" needs about",
             ),
+            opts(
+                "Integrator \"vcm\" \"integer photonsperiteration\" [2000000000]",
+                "\"integer photonsperiteration\"",
+                "Integrator \"vcm\" \"photonsperiteration\" needs about",
+            ),
         ],
     );
     // Each error names the parameter to change, after the limit.

@@ -236,6 +236,10 @@ pub fn finish(
         Settings::Vcm(mut settings) => {
             settings.radius = radius(warnings);
             settings.radius_from_density = plan.radius.is_none();
+            let light_paths = photon_scale::photons(settings.light_paths, scale);
+            let pilot =
+                settings.variance_lt && matches!(settings.mode, VcmMode::Vcm | VcmMode::Bpt);
+            photon_scale::claim_vcm(&ck, light_paths, pilot, scale, budget)?;
             Box::new(VcmIntegrator::new(settings))
         }
         Settings::PhotonMap(settings) => {

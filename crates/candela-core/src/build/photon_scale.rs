@@ -43,6 +43,7 @@ use crate::camera::{Camera, CameraSample};
 use crate::film::Film;
 use crate::integrator::photonmap::Photon;
 use crate::integrator::sppm::passes::PixelVisit;
+use crate::integrator::vcm;
 use crate::integrator::PhotonMapSettings;
 use crate::math::{Bounds3, Vec2};
 use crate::scene::Scene;
@@ -262,6 +263,43 @@ pub fn claim_progressive(
             ck.loc_of(name),
             ck.what
         ));
+    }
+    Ok(())
+}
+
+/// Claims the memory of one VCM iteration of `light_paths` light paths:
+/// its stored light vertices, counted at one per path (a lower bound: the
+/// vertices per path depend on the scene, 3.1 on the Cornell box and 0.3 on
+/// caustic-glass at one light path per pixel), and, with the variance pilot
+/// (`pilot`), both pilot passes' per-pixel estimates.
+pub fn claim_vcm(
+    ck: &Check<'_>,
+    light_paths: u64,
+    pilot: bool,
+    scale: &SceneScale,
+    budget: &mut Budget,
+) -> Result<(), BuildError> {
+    let each = (vcm::STORED_VERTEX_BYTES + 4) as u64;
+    budget
+        .claim(
+            light_paths.saturating_mul(each),
+            &format!("the light vertices of one iteration ({light_paths} light paths, {each} B each at least)"),
+            "lower \"photonsperiteration\"",
+        )
+        .map_err(|m| ck.error("photonsperiteration", m))?;
+    if pilot {
+        budget
+            .claim(
+                scale
+                    .pixels
+                    .saturating_mul(2 * vcm::PILOT_BYTES_PER_PIXEL as u64),
+                &format!(
+                    "the variance pilot's estimates of {} pixels in two passes",
+                    scale.pixels
+                ),
+                "lower the Film's resolution or crop it, or set \"string ltweights\" \"density\"",
+            )
+            .map_err(|m| BuildError::at(ck.loc, m))?;
     }
     Ok(())
 }

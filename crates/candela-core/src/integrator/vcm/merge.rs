@@ -25,7 +25,7 @@ use rayon::prelude::*;
 
 /// Bytes a merging iteration adds per stored vertex: its photon, and the
 /// grid's position, index and (about one per vertex) bucket start.
-pub(super) const MERGE_BYTES: usize =
+pub const MERGE_BYTES: usize =
     std::mem::size_of::<Photon>() + std::mem::size_of::<Vec3>() + 2 * std::mem::size_of::<u32>();
 
 /// What a merge needs of a stored light vertex (module docs).

@@ -161,6 +161,14 @@ use variance::LtWeights;
 /// about N_light × (mean non-specular light-subpath length) of them.
 pub const LIGHT_VERTEX_BYTES: usize = std::mem::size_of::<LightVertex>();
 
+/// Memory of one stored light vertex with its merge copy and grid entry,
+/// and of its light path's end index.
+pub const STORED_VERTEX_BYTES: usize = LIGHT_VERTEX_BYTES + merge::MERGE_BYTES;
+
+/// Memory per rendered pixel of one variance-pilot pass's estimates
+/// ([`variance`]), kept until the second pilot pass ends.
+pub const PILOT_BYTES_PER_PIXEL: usize = std::mem::size_of::<(UVec2, variance::ByLength)>();
+
 /// Which estimator the one VCM loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VcmMode {
