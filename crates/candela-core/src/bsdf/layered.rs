@@ -40,26 +40,36 @@
 //! for it, so samples carry `pdf_is_proportional` and integrators that need
 //! the density for MIS call [`LayeredBxdf::pdf`].
 //!
-//! **pdf(ωo, ωi)** is a stochastic estimate of the exit-direction density
-//! used only for MIS: the coating's reflection density plus a one-bounce
-//! (transmission–reflection–transmission) estimate mixing two strategies, blended
-//! with a 10 % uniform sphere density so it is never zero where f is not
-//! [pbrt-v4 §14.3.4].
+//! **pdf(ωo, ωi)** serves only MIS, so any density that is positive where f
+//! is and is used alike by every technique keeps the estimators unbiased. It
+//! is the coating's exact reflection density plus (1 − F(θo)) |cos θi|/π for
+//! the light that enters (as if the base re-emitted it diffusely), blended
+//! with a 10 % uniform sphere density so it is never zero where f is not.
+//! pbrt-v4 [§14.3.4] estimates the transmitted part stochastically (one
+//! base bounce, two random walks into the slab per call); that estimate cost
+//! 30 % of a VCM iteration on caustic-glass, where merges evaluate it for
+//! every light vertex in their disk. Measured with the closed form at equal
+//! sample counts (relMSE against long references, seeds 1–3): caustic-glass
+//! at half resolution vcm 0.02132/0.01470 against 0.02163/0.01501, path
+//! 0.06302/0.06364 against 0.06312/0.06377, bdpt 0.1680/0.1618 against
+//! 0.1686/0.1623; coated-killeroo (coateddiffuse and coatedconductor) path,
+//! bdpt and vcm within 0.7 % either way; 12 vcm iterations of caustic-glass
+//! in 1.62–1.85 s instead of 2.55–2.67 s.
 //!
 //! **Determinism.** Each call seeds its own [`Pcg32`] from a hash of its
-//! arguments — (ωo, ωi) for `f` and `pdf`, (ωo, uc, u) for `sample_f` — as
-//! pbrt-v4 does, so one query always returns the same value: the two MIS
-//! weights of a direction are computed from one pdf, and images do not
-//! depend on thread scheduling.
+//! arguments — (ωo, ωi) for `f`, (ωo, uc, u) for `sample_f` — as pbrt-v4
+//! does, so one query always returns the same value and images do not
+//! depend on thread scheduling; `pdf` is a closed form.
 
 mod eval;
 
+use super::fresnel::fr_dielectric;
 use super::{
     BsdfSample, BxdfFlags, ConductorBxdf, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode,
 };
-use crate::math::{lerp, local, Vec2, Vec3, INV_4PI};
+use crate::math::{lerp, local, Vec2, Vec3, INV_4PI, INV_PI};
 use crate::sampling::{
-    hash_u64s, power_heuristic, sample_exponential, sample_henyey_greenstein, Pcg32, PdfSolidAngle,
+    hash_u64s, sample_exponential, sample_henyey_greenstein, Pcg32, PdfSolidAngle,
 };
 use crate::spectrum::SampledSpectrum;
 
@@ -163,7 +173,6 @@ pub type CoatedConductorBxdf = LayeredBxdf<ConductorBxdf>;
 
 /// Stream tags that keep the random numbers of `f`, `pdf` and `sample_f` apart.
 const TAG_F: u64 = 0x4c46;
-const TAG_PDF: u64 = 0x4c50;
 const TAG_SAMPLE: u64 = 0x4c53;
 
 /// Bits of two floats in one word, for hashing.
@@ -375,8 +384,9 @@ impl<B: LayerBxdf> LayeredBxdf<B> {
         None
     }
 
-    /// Stochastic estimate of the exit-direction density, deterministic for
-    /// given directions [pbrt-v4 §14.3.4].
+    /// The exit-direction density used for MIS (module doc): the coating's
+    /// reflection density plus (1 − F(θo)) cos θi / π for what enters,
+    /// blended with a 10 % uniform sphere density.
     pub fn pdf(
         &self,
         wo: Vec3,
@@ -385,56 +395,15 @@ impl<B: LayerBxdf> LayeredBxdf<B> {
         allowed: SampleFlags,
     ) -> PdfSolidAngle {
         let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-        let mut rng = query_rng(TAG_PDF, dir_bits(wi), dir_bits(wo));
-        PdfSolidAngle(self.pdf_estimate(wo, wi, mode, allowed, &mut rng))
-    }
-
-    /// [`Self::pdf`] with the caller's random numbers.
-    pub(crate) fn pdf_estimate(
-        &self,
-        wo: Vec3,
-        wi: Vec3,
-        mode: TransportMode,
-        allowed: SampleFlags,
-        rng: &mut Pcg32,
-    ) -> f32 {
-        let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
         if wo.z == 0.0
             || !local::same_hemisphere(wo, wi)
             || !allowed.contains(SampleFlags::REFLECTION)
         {
-            return 0.0;
-        }
-        let mut sum = 0.0;
-        for _ in 0..self.params.n_samples {
-            sum += self.pdf_trt(wo, wi, mode, rng);
+            return PdfSolidAngle(0.0);
         }
         let entrance = self.top.pdf(wo, wi, mode, SampleFlags::REFLECTION).0;
-        lerp(0.9, INV_4PI, entrance + sum / self.params.n_samples as f32)
-    }
-
-    /// One estimate of the density of paths transmitted, reflected once by the
-    /// base, and transmitted out, MIS over two ways of choosing the inner directions.
-    fn pdf_trt(&self, wo: Vec3, wi: Vec3, mode: TransportMode, rng: &mut Pcg32) -> f32 {
-        let trans = SampleFlags::TRANSMISSION;
-        let wos = sample_layer(&self.top, wo, rng, mode, trans);
-        let wis = sample_layer(&self.top, wi, rng, mode.adjoint(), trans);
-        let (Some(wos), Some(wis)) = (wos, wis) else {
-            return 0.0;
-        };
-        if !self.top.flags().is_non_specular() {
-            return self.bottom.pdf(-wos.wi, -wis.wi, mode, SampleFlags::ALL).0;
-        }
-        let Some(rs) = sample_layer(&self.bottom, -wos.wi, rng, mode, SampleFlags::ALL) else {
-            return 0.0;
-        };
-        if !self.bottom.flags().is_non_specular() {
-            return self.top.pdf(-rs.wi, wi, mode, SampleFlags::ALL).0;
-        }
-        let r_pdf = self.bottom.pdf(-wos.wi, -wis.wi, mode, SampleFlags::ALL).0;
-        let t_pdf = self.top.pdf(-rs.wi, wi, mode, SampleFlags::ALL).0;
-        power_heuristic(1.0, wis.pdf.0, 1.0, r_pdf) * r_pdf
-            + power_heuristic(1.0, rs.pdf.0, 1.0, t_pdf) * t_pdf
+        let enters = 1.0 - fr_dielectric(wo.z, self.top.eta);
+        PdfSolidAngle(lerp(0.9, INV_4PI, entrance + enters * wi.z.abs() * INV_PI))
     }
 }
 
