@@ -42,19 +42,15 @@
 //!
 //! **pdf(ωo, ωi)** serves only MIS, so any density that is positive where f
 //! is and is used alike by every technique keeps the estimators unbiased. It
-//! is the coating's exact reflection density plus (1 − F(θo)) |cos θi|/π for
-//! the light that enters (as if the base re-emitted it diffusely), blended
-//! with a 10 % uniform sphere density so it is never zero where f is not.
-//! pbrt-v4 [§14.3.4] estimates the transmitted part stochastically (one
-//! base bounce, two random walks into the slab per call); that estimate cost
-//! 30 % of a VCM iteration on caustic-glass, where merges evaluate it for
-//! every light vertex in their disk. Measured with the closed form at equal
-//! sample counts (relMSE against long references, seeds 1–3): caustic-glass
-//! at half resolution vcm 0.02132/0.01470 against 0.02163/0.01501, path
-//! 0.06302/0.06364 against 0.06312/0.06377, bdpt 0.1680/0.1618 against
-//! 0.1686/0.1623; coated-killeroo (coateddiffuse and coatedconductor) path,
-//! bdpt and vcm within 0.7 % either way; 12 vcm iterations of caustic-glass
-//! in 1.62–1.85 s instead of 2.55–2.67 s.
+//! is a closed form: the coating's exact reflection density, plus for the
+//! light that enters (1 − F(θo)) the base's density of the pair ωo', ωi'
+//! that a smooth coating refracts into ωo, ωi, carried out of the slab by
+//! dω'/dω = cos θi / (η² cos θi'), blended with a 10 % uniform sphere density
+//! so it is never zero where f is not. An index-matched coating gives the
+//! base's density exactly. pbrt-v4 [§14.3.4] estimates the transmitted part
+//! stochastically (one base bounce, two random walks into the slab per
+//! call); that estimate cost 30 % of a VCM iteration on caustic-glass,
+//! where merges evaluate it for every light vertex in their disk.
 //!
 //! **Determinism.** Each call seeds its own [`Pcg32`] from a hash of its
 //! arguments — (ωo, ωi) for `f`, (ωo, uc, u) for `sample_f` — as pbrt-v4
@@ -67,7 +63,7 @@ use super::fresnel::fr_dielectric;
 use super::{
     BsdfSample, BxdfFlags, ConductorBxdf, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode,
 };
-use crate::math::{lerp, local, Vec2, Vec3, INV_4PI, INV_PI};
+use crate::math::{lerp, local, Vec2, Vec3, INV_4PI};
 use crate::sampling::{
     hash_u64s, sample_exponential, sample_henyey_greenstein, Pcg32, PdfSolidAngle,
 };
@@ -385,8 +381,8 @@ impl<B: LayerBxdf> LayeredBxdf<B> {
     }
 
     /// The exit-direction density used for MIS (module doc): the coating's
-    /// reflection density plus (1 − F(θo)) cos θi / π for what enters,
-    /// blended with a 10 % uniform sphere density.
+    /// reflection density plus, for what enters, the base's density of the
+    /// refracted pair, blended with a 10 % uniform sphere density.
     pub fn pdf(
         &self,
         wo: Vec3,
@@ -402,9 +398,27 @@ impl<B: LayerBxdf> LayeredBxdf<B> {
             return PdfSolidAngle(0.0);
         }
         let entrance = self.top.pdf(wo, wi, mode, SampleFlags::REFLECTION).0;
-        let enters = 1.0 - fr_dielectric(wo.z, self.top.eta);
-        PdfSolidAngle(lerp(0.9, INV_4PI, entrance + enters * wi.z.abs() * INV_PI))
+        let eta = self.top.eta;
+        let trt = match (inside(wo, eta), inside(wi, eta)) {
+            (Some(o), Some(i)) => {
+                // The base's density of the refracted pair, carried out of
+                // the slab by dω' / dω = cos θ / (η² cos θ').
+                let base = self.bottom.pdf(o, i, mode, SampleFlags::ALL).0;
+                (1.0 - fr_dielectric(wo.z, eta)) * base * wi.z.abs() / (eta * eta * i.z)
+            }
+            _ => 0.0,
+        };
+        PdfSolidAngle(lerp(0.9, INV_4PI, entrance + trt))
     }
+}
+
+/// The direction inside a slab of index `eta` (over 1 outside) that the
+/// smooth coating refracts into `w` (both pointing up, `w.z > 0`), by Snell's
+/// law; `None` past the critical angle.
+fn inside(w: Vec3, eta: f32) -> Option<Vec3> {
+    let (x, y) = (w.x / eta, w.y / eta);
+    let z2 = 1.0 - x * x - y * y;
+    (z2 > 0.0).then(|| Vec3::new(x, y, z2.sqrt()))
 }
 
 /// The reflected sample of a walk that left the slab along `w`: specular
