@@ -4,6 +4,43 @@
 use super::{brute_force, compare, paths, Path, Technique, DIRECT};
 use super::{DirectMerges, Emitter};
 
+/// Over the first `n` random paths that `keep` accepts and on which the
+/// techniques `uses` carry at least `min_share` of the (brute-force)
+/// weight, compares the recursion given `perturb(path)` with the truth:
+/// (caught, tried), caught counting the paths the main test's criterion
+/// rejects.
+fn catches(
+    n: usize,
+    direct: DirectMerges,
+    keep: impl Fn(&Path) -> bool,
+    uses: impl Fn(&Path, &Technique) -> bool,
+    min_share: f64,
+    perturb: impl Fn(&Path) -> Path,
+) -> (u32, u32) {
+    let (mut caught, mut tried) = (0, 0);
+    for p in paths().take(n) {
+        if !keep(&p) || p.delta[1..].iter().any(|&d| d) {
+            continue;
+        }
+        let brute = brute_force(&p, direct);
+        let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
+        let share: f64 = brute
+            .iter()
+            .filter(|(t, _)| uses(&p, t))
+            .map(|(_, q)| q * q / total)
+            .sum();
+        if share < min_share {
+            continue;
+        }
+        let Some(m) = compare(&p, &perturb(&p), direct) else {
+            continue;
+        };
+        tried += 1;
+        caught += !m.agrees() as u32;
+    }
+    (caught, tried)
+}
+
 /// The check can fail: a density given to the recursion that is not the
 /// path's (x_2's camera-side direction density, that of x_1, 30 % high) is
 /// caught by the main test's criterion on every path of 2+ segments
@@ -14,31 +51,18 @@ use super::{DirectMerges, Emitter};
 #[test]
 fn a_perturbed_density_is_caught() {
     for direct in DIRECT {
-        let (mut caught, mut tried) = (0, 0);
-        for p in paths().take(600) {
-            if p.m() < 2 || p.delta[1..].iter().any(|&d| d) {
-                continue;
-            }
-            let brute = brute_force(&p, direct);
-            let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
-            let uses_it =
-                |t: &Technique| matches!(t, Technique::Connect(0 | 1) | Technique::Merge(1));
-            let share: f64 = brute
-                .iter()
-                .filter(|(t, _)| uses_it(t))
-                .map(|(_, q)| q * q / total)
-                .sum();
-            if share < 1e-6 {
-                continue;
-            }
-            let mut given = p.clone();
-            given.pe_dir[2] *= 1.3;
-            let Some(m) = compare(&p, &given, direct) else {
-                continue;
-            };
-            tried += 1;
-            caught += !m.agrees() as u32;
-        }
+        let (caught, tried) = catches(
+            600,
+            direct,
+            |p| p.m() >= 2,
+            |_, t| matches!(t, Technique::Connect(0 | 1) | Technique::Merge(1)),
+            1e-6,
+            |p| {
+                let mut given = p.clone();
+                given.pe_dir[2] *= 1.3;
+                given
+            },
+        );
         assert!(
             tried > 50 && caught == tried,
             "{direct:?}: {caught}/{tried}"
@@ -54,33 +78,17 @@ fn a_perturbed_density_is_caught() {
 /// and the two densities differ by more than 20 %.
 #[test]
 fn the_next_event_density_is_the_samplers() {
-    let (mut caught, mut tried) = (0, 0);
-    for p in paths().take(1200) {
-        let differ = (p.p_nee / p.p_pos - 1.0).abs() > 0.2;
-        if p.light != Emitter::Area || !differ || p.delta[1..].iter().any(|&d| d) {
-            continue;
-        }
-        let direct = DirectMerges::AfterSpecular;
-        let brute = brute_force(&p, direct);
-        let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
-        let share: f64 = brute
-            .iter()
-            .filter(|(t, _)| matches!(t, Technique::Connect(0 | 1)))
-            .map(|(_, q)| q * q / total)
-            .sum();
-        if share < 1e-3 {
-            continue;
-        }
-        let given = Path {
+    let (caught, tried) = catches(
+        1200,
+        DirectMerges::AfterSpecular,
+        |p| p.light == Emitter::Area && (p.p_nee / p.p_pos - 1.0).abs() > 0.2,
+        |_, t| matches!(t, Technique::Connect(0 | 1)),
+        1e-3,
+        |p| Path {
             p_nee: p.p_pos,
             ..p.clone()
-        };
-        let Some(m) = compare(&p, &given, direct) else {
-            continue;
-        };
-        tried += 1;
-        caught += !m.agrees() as u32;
-    }
+        },
+    );
     assert!(tried > 50 && caught == tried, "{caught}/{tried}");
 }
 
@@ -90,32 +98,16 @@ fn the_next_event_density_is_the_samplers() {
 /// 1e-3 of the weight.
 #[test]
 fn the_light_tracing_factor_is_applied() {
-    let (mut caught, mut tried) = (0, 0);
-    for p in paths().take(1200) {
-        if p.lt_c > 0.8 || p.delta[1..].iter().any(|&d| d) {
-            continue;
-        }
-        let direct = DirectMerges::AfterSpecular;
-        let brute = brute_force(&p, direct);
-        let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
-        let lt = Technique::Connect(p.m() + 1);
-        let share: f64 = brute
-            .iter()
-            .filter(|(t, _)| *t == lt)
-            .map(|(_, q)| q * q / total)
-            .sum();
-        if share < 1e-3 {
-            continue;
-        }
-        let given = Path {
+    let (caught, tried) = catches(
+        1200,
+        DirectMerges::AfterSpecular,
+        |p| p.lt_c <= 0.8,
+        |p, t| *t == Technique::Connect(p.m() + 1),
+        1e-3,
+        |p| Path {
             lt_c: 1.0,
             ..p.clone()
-        };
-        let Some(m) = compare(&p, &given, direct) else {
-            continue;
-        };
-        tried += 1;
-        caught += !m.agrees() as u32;
-    }
+        },
+    );
     assert!(tried > 50 && caught == tried, "{caught}/{tried}");
 }
