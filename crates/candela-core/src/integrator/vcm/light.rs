@@ -235,9 +235,8 @@ type Lane = (Option<SplatBuffer>, Vec<(u64, PathChunk)>);
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
     /// `lambda` and time `time`, splatting their camera connections weighed
-    /// with light tracing's factors `lt` when given (the pilots want only the
-    /// vertices); `None` if the
-    /// render was cancelled.
+    /// with light tracing's factors `lt` when given (the radius pilot wants
+    /// only the vertices); `None` if the render was cancelled.
     pub(super) fn light_pass(
         &self,
         ctx: &RenderContext<'_>,
