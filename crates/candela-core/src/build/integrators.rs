@@ -465,6 +465,11 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
         connections,
         direct_merges: vcm_direct_merges(ck, mode)?,
         variance_lt: vcm_lt_weights(ck)?,
+        join_roulette: ck.float(
+            "joinroulette",
+            VcmSettings::default().join_roulette,
+            Domain::Closed(0.0, 1.0),
+        )?,
     })
 }
 

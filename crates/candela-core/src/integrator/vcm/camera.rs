@@ -22,7 +22,7 @@
 use super::densities::light_densities;
 use super::light::{LightPaths, LightVertex, PrevVertex};
 use super::merge::MergeGrid;
-use super::mis::{weight, CameraDeferred, CameraPartial, Factors, Partial};
+use super::mis::{thin, weight, CameraDeferred, CameraPartial, Factors, Partial};
 use super::resample::Resampler;
 use super::variance::{ByLength, LtWeights, LENGTHS};
 use super::{Connections, VcmIntegrator};
@@ -392,45 +392,54 @@ impl CameraVisitor<'_, '_> {
     /// unoccluded contribution ([`Connections`], module doc of [`super`]).
     fn connect(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool, rng: &mut Sampler) {
         let max_depth = self.vcm.settings.max_depth;
+        let tau = self.vcm.settings.join_roulette;
         let path = self.path;
         let joinable = path.iter().take_while(|lv| lv.depth + v.depth <= max_depth);
         let scene = self.ctx.scene;
         match self.vcm.settings.connections {
             Connections::All => {
                 for lv in joinable {
-                    let Some(x) = self.connection(v, cb, lv, terminated) else {
+                    let Some((x, w)) = self.connection(v, cb, lv, terminated) else {
+                        continue;
+                    };
+                    let Some(kept) = thin(w, tau, || rng.u1()) else {
                         continue;
                     };
                     if scene.unoccluded(&lv.it, &v.it) {
-                        self.add(v.depth + lv.depth, x);
+                        self.add(v.depth + lv.depth, x * (kept / w));
                     }
                 }
             }
             Connections::One => {
                 let mut r = Resampler::new(rng.u1());
                 for lv in joinable {
-                    if let Some(x) = self.connection(v, cb, lv, terminated) {
-                        r.offer((lv, x), x.average());
+                    if let Some((x, w)) = self.connection(v, cb, lv, terminated) {
+                        r.offer((lv, x, w), x.average());
                     }
                 }
-                if let Some(((lv, x), inv_p)) = r.pick() {
-                    if scene.unoccluded(&lv.it, &v.it) {
-                        self.add(v.depth + lv.depth, x * inv_p);
-                    }
+                let Some(((lv, x, w), inv_p)) = r.pick() else {
+                    return;
+                };
+                let Some(kept) = thin(w, tau, || rng.u1()) else {
+                    return;
+                };
+                if scene.unoccluded(&lv.it, &v.it) {
+                    self.add(v.depth + lv.depth, x * (inv_p * kept / w));
                 }
             }
         }
     }
 
     /// The MIS-weighted contribution of joining `v` to light vertex `lv`
-    /// if nothing lies between them [eqs. 40–41]; `None` when it is zero.
+    /// if nothing lies between them [eqs. 40–41], and its weight; `None`
+    /// when it is zero.
     fn connection(
         &self,
         v: &Vertex,
         cb: &Bsdf,
         lv: &LightVertex,
         terminated: bool,
-    ) -> Option<SampledSpectrum> {
+    ) -> Option<(SampledSpectrum, f32)> {
         let d = lv.p() - v.p();
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -457,7 +466,7 @@ impl CameraVisitor<'_, '_> {
             self.partial(v.depth + lv.depth)
                 .connect_weight(light_dir_a, cam_rev.0, f, true);
         let mw = weight(w_light, w_cam);
-        (mw != 0.0).then(|| unfold(c * mw, terminated, lv.terminated))
+        (mw != 0.0).then(|| (unfold(c * mw, terminated, lv.terminated), mw))
     }
 
     /// Merges with the iteration's light vertices around `v` [eqs. 38–39].

@@ -17,7 +17,7 @@
 //! iteration at 128².
 
 use super::densities::light_densities;
-use super::mis::{weight, Deferred, DirectMerges, Factors, Partial};
+use super::mis::{thin, weight, Deferred, DirectMerges, Factors, Partial};
 use super::variance::LtWeights;
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
@@ -543,7 +543,15 @@ impl LightVisitor<'_, '_> {
                 weight(w_light / c, 0.0)
             }
         };
-        if w == 0.0 || !ctx.scene.unoccluded(&v.it, &cs.p_lens) {
+        let tau = if self.vcm.techniques.light_only {
+            0.0
+        } else {
+            self.vcm.settings.join_roulette
+        };
+        let Some(w) = thin(w, tau, || rng.u1()) else {
+            return;
+        };
+        if !ctx.scene.unoccluded(&v.it, &cs.p_lens) {
             return;
         }
         let scale = w * self.vcm.splat_scale(ctx);

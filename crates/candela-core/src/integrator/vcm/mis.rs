@@ -402,6 +402,29 @@ impl CameraPartial {
     }
 }
 
+/// Russian roulette on a join by its MIS weight `w` (`"float
+/// joinroulette"` τ): a join with w ≥ τ is made and keeps w; one with
+/// w < τ is made with probability q = w/τ (`u` draws the uniform only
+/// then) and then counts with w/q = τ. Its expected contribution is
+/// unchanged, q·(X τ) = X w, so every technique keeps its weighted
+/// expectation and the estimator stays unbiased [Veach 1997, §10.4.1 on
+/// roulette by a path's expected contribution]; what is saved is the
+/// shadow ray (and the splat) of joins whose weight would have made them
+/// count little, which adds at most X²·w·τ of variance per join. τ = 0
+/// makes every join of positive weight.
+#[inline]
+pub fn thin(w: f32, tau: f32, u: impl FnOnce() -> f32) -> Option<f32> {
+    if w <= 0.0 {
+        None
+    } else if w >= tau {
+        Some(w)
+    } else if u() * tau < w {
+        Some(tau)
+    } else {
+        None
+    }
+}
+
 /// The full-path weight of eq. 37.
 #[inline]
 pub fn weight(w_light: f32, w_camera: f32) -> f32 {
@@ -416,6 +439,29 @@ pub fn weight(w_light: f32, w_camera: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Thinning keeps a join's expected weight: over stratified uniforms
+    /// the kept weights average to w (to 1/n), and joins at or above τ
+    /// are kept as they are. Counting a survivor with w instead of τ (a
+    /// roulette without its 1/q) would average w²/τ and fail here.
+    #[test]
+    fn thinning_keeps_the_expected_weight() {
+        let n = 10_000;
+        for (w, tau) in [(0.003f32, 0.1f32), (0.05, 0.1), (0.099, 0.1), (0.2, 0.5)] {
+            let mean: f64 = (0..n)
+                .filter_map(|i| thin(w, tau, || (i as f32 + 0.5) / n as f32))
+                .map(f64::from)
+                .sum::<f64>()
+                / n as f64;
+            assert!(
+                (mean - f64::from(w)).abs() <= f64::from(tau) / n as f64,
+                "{w} {tau} {mean}"
+            );
+        }
+        assert_eq!(thin(0.3, 0.1, || panic!("no draw above τ")), Some(0.3));
+        assert_eq!(thin(0.3, 0.0, || panic!("no draw at τ = 0")), Some(0.3));
+        assert_eq!(thin(0.0, 0.1, || 0.0), None);
+    }
 
     /// A two-segment path light → x → camera on a diffuse x: with only
     /// connections (bpt) its techniques are NEE at x (s = 1), light
