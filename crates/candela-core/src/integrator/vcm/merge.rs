@@ -74,19 +74,37 @@ pub(super) struct MergeGrid {
 
 impl MergeGrid {
     /// The grid for merge radius `radius` over the stored vertices of `light`.
-    /// The photons are made and reordered in parallel; only the grid's
-    /// counting sort is serial.
+    /// The grid is built over their positions alone (12 bytes a vertex,
+    /// gathered on one thread), and each photon is made once, in parallel,
+    /// straight into its entry slot: collecting the photons first through
+    /// rayon's `flat_map_iter` and then reordering them cost 2.3 + 1.2 ms
+    /// of a 65-ms Cornell box iteration at 128² on 2 threads, against
+    /// 0.7 ms for the grid itself.
     pub fn build(light: &LightPaths, radius: f32) -> Self {
-        let photons: Vec<Photon> = light
-            .chunks()
-            .par_iter()
-            .flat_map_iter(|c| c.iter().map(Photon::new))
+        let chunks = light.chunks();
+        let positions: Vec<Vec3> = chunks
+            .iter()
+            .flat_map(|c| c.iter().map(|v| v.it.p))
             .collect();
-        let grid = HashGrid::build(&photons, radius);
+        let grid = HashGrid::build(&positions, radius);
+        // First global index of each chunk, to find an entry's vertex.
+        let starts: Vec<usize> = chunks
+            .iter()
+            .scan(0, |n, c| {
+                let s = *n;
+                *n += c.len();
+                Some(s)
+            })
+            .collect();
+        let vertex = |i: u32| {
+            let i = i as usize;
+            let c = starts.partition_point(|&s| s <= i) - 1;
+            &chunks[c][i - starts[c]]
+        };
         let photons = grid
             .entry_order()
             .par_iter()
-            .map(|&i| photons[i as usize])
+            .map(|&i| Photon::new(vertex(i)))
             .collect();
         MergeGrid { grid, photons }
     }
