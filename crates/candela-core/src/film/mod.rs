@@ -27,7 +27,7 @@ pub use block::PassBlock;
 pub use develop::{Channel, Developed};
 pub use layout::{Aov, Buckets, FilmLayout, SurfaceAov};
 pub use state::{FilmState, MergeError, PassSet};
-pub use tile::{FilmTile, SplatBuffer, SurfaceSample};
+pub use tile::{FilmTile, SplatBuffer, SplatRecord, SurfaceSample};
 
 use crate::math::{Mat3, UVec2};
 use crate::spectrum::{ColorSpace, PixelSensor};

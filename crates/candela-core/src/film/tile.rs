@@ -232,6 +232,18 @@ pub struct SplatBuffer {
     inv_filter_integral: f32,
     enc: Encoder,
     pub(crate) dropped: u64,
+    /// When recording, the splats in the order they came instead of sums
+    /// ([`SplatBuffer::recording`]).
+    records: Option<Vec<SplatRecord>>,
+}
+
+/// One splat as [`SplatBuffer::add`] was called with it, to be replayed
+/// into a summing buffer later.
+#[derive(Clone, Copy, Debug)]
+pub struct SplatRecord {
+    p: Vec2,
+    l: SampledSpectrum,
+    lambda: SampledWavelengths,
 }
 
 impl SplatBuffer {
@@ -250,6 +262,38 @@ impl SplatBuffer {
             filter,
             enc,
             dropped: 0,
+            records: None,
+        }
+    }
+
+    /// A buffer over no pixels that records what [`Self::add`] is given
+    /// instead of summing it; [`Self::take_records`] hands the records over
+    /// and [`Self::replay`] adds them to a summing buffer in the same order,
+    /// with the same result as adding them there directly.
+    pub fn recording(film: &super::Film) -> Self {
+        Self::empty_at(film.pixel_bounds().0, film).into_recording()
+    }
+
+    /// This buffer, recording from now on ([`Self::recording`]).
+    fn into_recording(self) -> Self {
+        Self {
+            records: Some(Vec::new()),
+            ..self
+        }
+    }
+
+    /// The splats recorded since the last call (none when not recording).
+    pub fn take_records(&mut self) -> Vec<SplatRecord> {
+        self.records
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
+    /// Adds recorded splats in their order ([`Self::add`] on each).
+    pub fn replay(&mut self, records: &[SplatRecord]) {
+        for r in records {
+            self.add(r.p, r.l, &r.lambda);
         }
     }
 
@@ -274,6 +318,14 @@ impl SplatBuffer {
     /// over the pixels around it (ignored outside the pixel bounds;
     /// non-finite values are dropped and counted).
     pub fn add(&mut self, p: Vec2, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        if let Some(r) = &mut self.records {
+            r.push(SplatRecord {
+                p,
+                l,
+                lambda: *lambda,
+            });
+            return;
+        }
         if l.has_non_finite() {
             self.dropped += 1;
             return;
@@ -327,6 +379,10 @@ impl SplatBuffer {
     /// Adds an estimate of the radiance of `pixel` itself (PPM's per-pass
     /// pixel values: no filtering); non-finite values are dropped and counted.
     pub fn add_pixel(&mut self, pixel: UVec2, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        debug_assert!(
+            self.records.is_none(),
+            "a recording buffer records add() only"
+        );
         if l.has_non_finite() {
             self.dropped += 1;
             return;
@@ -353,5 +409,59 @@ impl SplatBuffer {
     /// (for estimators that never splat).
     pub fn empty_at(lo: UVec2, film: &super::Film) -> Self {
         SplatBuffer::new(lo, lo, film.filter().clone(), film.encoder_for_empty())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::PixelSensor;
+
+    fn buffer(lo: UVec2, hi: UVec2) -> SplatBuffer {
+        let enc = Encoder {
+            sensor: PixelSensor::cie1931(1.0),
+            max_component_value: f32::INFINITY,
+            buckets: None,
+            luminance: false,
+        };
+        SplatBuffer::new(lo, hi, Filter::default(), enc)
+    }
+
+    /// Splats recorded and replayed sum to the same bits as splats added
+    /// directly, in the same order (a reversed replay fails) (the driver's determinism rests on it), non-finite ones
+    /// dropped and counted alike; a recording buffer sums nothing itself.
+    #[test]
+    fn replayed_splats_equal_direct_ones_bit_for_bit() {
+        let (lo, hi) = (UVec2::new(2, 1), UVec2::new(14, 9));
+        let (mut direct, mut rec) = (buffer(lo, hi), buffer(lo, lo).into_recording());
+        let mut u = 0.137f32;
+        let mut next = || {
+            u = (u * 97.31 + 0.417).fract();
+            u
+        };
+        for i in 0..500 {
+            let p = Vec2::new(16.0 * next(), 10.0 * next());
+            let lambda = SampledWavelengths::sample_visible(next());
+            // Magnitudes 1e-6 to 1e7, so that f64 sums round and order shows.
+            let scale = 10f32.powi(i % 14 - 6);
+            let v = if i % 97 == 0 {
+                f32::NAN
+            } else {
+                scale * next()
+            };
+            let l = SampledSpectrum::from_fn(|k| v * (k as f32 + next()));
+            direct.add(p, l, &lambda);
+            rec.add(p, l, &lambda);
+        }
+        assert!(rec.sums.is_empty() && rec.dropped == 0);
+        let records = rec.take_records();
+        assert_eq!(records.len(), 500);
+        assert!(rec.take_records().is_empty());
+        let mut replayed = buffer(lo, hi);
+        replayed.replay(&records);
+        assert!(direct.sums.iter().any(|&v| v > 0.0));
+        let bits = |b: &SplatBuffer| b.sums.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&direct), bits(&replayed));
+        assert_eq!((direct.dropped, replayed.dropped), (6, 6));
     }
 }
