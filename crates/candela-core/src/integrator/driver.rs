@@ -11,8 +11,9 @@
 //! lanes in parallel), and lanes are added to the block in order, so splat
 //! sums do not depend on the thread count either. Tiles, not lanes, are
 //! the tasks: with lanes as tasks two threads shared eight units of work
-//! per pass and waited for each other at its end (the path tracer scaled
-//! 1.67× from one thread to two on the Cornell box, 1.84× with tiles).
+//! per pass and waited for each other at its end (from one thread to two
+//! on the Cornell box, `bench/peers_speed.py --cases scaling`: the path
+//! tracer 1.60× with lanes, 1.92× with tiles; BDPT 1.68×, 1.89×).
 
 use super::{PassOutcome, PixelEstimator, RenderContext};
 use crate::camera::CameraSample;
@@ -36,8 +37,10 @@ pub fn render_pixels(
 ) -> PassOutcome {
     let tiles = tiles(ctx.film.pixel_bounds());
     // Rendered a batch at a time, so the recorded splats of a batch are all
-    // that is held (a few MB); a batch is enough tiles that its end costs two
-    // threads at most a tile each.
+    // that is held: 512 tiles of 256 pixels, 56 bytes a splat, 7.3 MB per
+    // splat per pixel sample (BDPT makes one per light vertex that sees the
+    // lens). A batch is enough tiles that its end idles a thread for at most
+    // one tile of 256 per thread.
     const BATCH: usize = 64 * LANES;
     let mut lanes: Vec<Option<SplatBuffer>> = (0..LANES).map(|_| None).collect();
     for (b, batch) in tiles.chunks(BATCH).enumerate() {

@@ -205,7 +205,8 @@ pub trait PixelEstimator: Send + Sync {
         splats: &mut SplatBuffer,
     ) -> SampledSpectrum;
 
-    /// True when [`PixelEstimator::li`] splats (the driver then allocates splat buffers).
+    /// True when [`PixelEstimator::li`] splats: the driver then sums the splats
+    /// it records per tile into splat buffers (module doc of [`driver`]).
     fn splats(&self) -> bool {
         false
     }
