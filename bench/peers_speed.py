@@ -21,7 +21,12 @@ medians are printed, so load from other processes skews both sides alike):
   `scalar_spectral` path tracer on the same geometry (built by
   bench/cornell_vs_mitsuba.py; Mitsuba's scene load is not counted), candela /
   Mitsuba (target <= 0.8). killeroo-simple is not compared with Mitsuba: its
-  `coateddiffuse` material has no Mitsuba counterpart.
+  `coateddiffuse` material has no Mitsuba counterpart. The two do not do the
+  same work per sample: candela plays Russian roulette from the second bounce
+  (pbrt-v4's rule), Mitsuba from the fifth (`rr_depth` 5), so at equal spp
+  Mitsuba's image is less noisy (0.0049 against 0.0060 at 64 spp) and
+  candela's is cheaper; with roulette from the fifth bounce candela's noise
+  equals Mitsuba's and its time grows 23 %, so its noise x time is unchanged.
 - sppm: SPPM on caustic-glass at equal time (--seconds, default 30), relMSE
   over the image and in the caustic, each renderer against its own converged
   image (candela: its BDPT at --ref-spp, cached in bench/out/peers; pbrt-v4:
