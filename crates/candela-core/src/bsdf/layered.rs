@@ -59,7 +59,7 @@
 
 mod eval;
 
-use super::fresnel::fr_dielectric;
+use super::fresnel::{fr_dielectric, refract};
 use super::{
     BsdfSample, BxdfFlags, ConductorBxdf, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode,
 };
@@ -412,13 +412,11 @@ impl<B: LayerBxdf> LayeredBxdf<B> {
     }
 }
 
-/// The direction inside a slab of index `eta` (over 1 outside) that the
-/// smooth coating refracts into `w` (both pointing up, `w.z > 0`), by Snell's
-/// law; `None` past the critical angle.
+/// The direction inside a slab of index `eta` under a smooth coating that
+/// refracts into `w` (`w.z ≥ 0`), turned to point up as `w` does; `None`
+/// under total internal reflection.
 fn inside(w: Vec3, eta: f32) -> Option<Vec3> {
-    let (x, y) = (w.x / eta, w.y / eta);
-    let z2 = 1.0 - x * x - y * y;
-    (z2 > 0.0).then(|| Vec3::new(x, y, z2.sqrt()))
+    refract(w, Vec3::Z, eta).map(|(t, _)| -t)
 }
 
 /// The reflected sample of a walk that left the slab along `w`: specular
