@@ -543,12 +543,8 @@ impl LightVisitor<'_, '_> {
                 weight(w_light / c, 0.0)
             }
         };
-        let tau = if self.vcm.techniques.light_only {
-            0.0
-        } else {
-            self.vcm.settings.join_roulette
-        };
-        let Some(w) = thin(w, tau, || rng.u1()) else {
+        // Light tracing alone has w = 1, which no τ ≤ 1 thins.
+        let Some(w) = thin(w, self.vcm.settings.join_roulette, || rng.u1()) else {
             return;
         };
         if !ctx.scene.unoccluded(&v.it, &cs.p_lens) {

@@ -178,8 +178,8 @@ use variance::LtWeights;
 /// about N_light × (mean non-specular light-subpath length) of them.
 pub const LIGHT_VERTEX_BYTES: usize = std::mem::size_of::<LightVertex>();
 
-/// Memory of one stored light vertex with its merge copy and grid entry,
-/// and of its light path's end index.
+/// Memory of one stored light vertex with its merge copy and grid entry
+/// (the claim at build time adds its light path's 4-byte end index).
 pub const STORED_VERTEX_BYTES: usize = LIGHT_VERTEX_BYTES + merge::MERGE_BYTES;
 
 /// Memory per rendered pixel of one variance-pilot pass's estimates

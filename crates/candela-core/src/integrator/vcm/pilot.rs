@@ -29,6 +29,15 @@
 //! holds almost every vertex, cannot choose an absurd kernel; with no
 //! vertex at all the footprint default stays.
 //!
+//! Checked (with K = 2 and every vertex merging) beyond the three scenes
+//! it was fitted on (relMSE against long path-traced references):
+//! env-metals (an environment light; the pilot
+//! takes the upper bound, 6 footprints; 8 s, one seed) 0.00022 against
+//! 0.00024 at one footprint; killeroo-simple at 176² (4.7 footprints; 16 s,
+//! two seeds) 0.0015–0.0018 against 0.0014–0.0017, 8 % worse: its light
+//! vertices spread over a floor far larger than the view, and the median
+//! vertex, not the median visible point, sets the radius.
+//!
 //! **The lower bound, 2 footprints.** Where light vertices are dense (the
 //! Cornell box: K = 3 gives 1.4 footprints, radius 0.026 at half
 //! resolution) a kernel of about one pixel leaves the merges noisy early
@@ -41,15 +50,6 @@
 //! to the light). The equal-time benchmark's early points are the ones
 //! that missed its target. The other scenes checked are above 2 footprints
 //! already.
-
-//! Checked (with K = 2 and every vertex merging) beyond the three scenes
-//! it was fitted on (relMSE against long path-traced references):
-//! env-metals (an environment light; the pilot
-//! takes the upper bound, 6 footprints; 8 s, one seed) 0.00022 against
-//! 0.00024 at one footprint; killeroo-simple at 176² (4.7 footprints; 16 s,
-//! two seeds) 0.0015–0.0018 against 0.0014–0.0017, 8 % worse: its light
-//! vertices spread over a floor far larger than the view, and the median
-//! vertex, not the median visible point, sets the radius.
 
 use super::light::LightVertex;
 use super::mis::{DirectMerges, Factors};
@@ -177,9 +177,10 @@ mod tests {
     /// Uniform points of density ρ: the disk of radius r around a point
     /// holds Poisson(ρπr²) others, so the K-neighbour radius is
     /// √(K / (ρπ)). At ρ = 10⁶ on the unit square, with footprints of ½
-    /// and ¼ of that radius (inside the bounds, 2–6 footprints), the pilot's probes (4 footprints, doubled while the median
-    /// count is below 16) end at 4 times that radius and hold λ = 16K = 48
-    /// others on average. The median of Poisson(λ)
+    /// and ¼ of that radius (inside the bounds, 2–6 footprints), the
+    /// pilot's probes (4 footprints, doubled while the median count is
+    /// below 16) end at 4 times that radius and hold λ = 16K = 48 others on
+    /// average. The median of Poisson(λ)
     /// for an integer λ is λ (P(X ≤ λ−1) < ½ ≤ P(X ≤ λ)); the empirical
     /// median over 8192 queries moves the CDF by ~0.0055 (1σ, about a
     /// tenth of a count here), and the points within a probe radius of the
