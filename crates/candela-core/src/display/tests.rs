@@ -60,10 +60,18 @@ fn read_one(l: &TcpListener) -> Vec<u8> {
     v
 }
 
-/// An address nobody listens on.
+/// An address nobody listens on: the kernel refuses every connection to
+/// port 0. (A port freed by dropping a listener is not dead for certain: a
+/// test running in parallel may be given it.)
 fn dead_address() -> SocketAddr {
-    let l = TcpListener::bind("127.0.0.1:0").unwrap();
-    l.local_addr().unwrap()
+    SocketAddr::from(([127, 0, 0, 1], 0))
+}
+
+/// Serialises the tests that bind listeners, so that a port one test frees
+/// and binds again cannot be handed to another in between.
+fn sockets() -> std::sync::MutexGuard<'static, ()> {
+    static SOCKETS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    SOCKETS.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Options for a test: short timeouts, no retries.
@@ -168,6 +176,7 @@ fn update_packets_cover_an_odd_sized_image_exactly_once() {
 
 #[test]
 fn client_stream_decodes_to_the_frame_sent() {
+    let _sockets = sockets();
     let (addr, rx) = viewer();
     let f = test_frame(130, 129, &["R", "G", "B"], 2.0);
     let mut c = TevClient::connect(&addr.to_string(), Duration::from_secs(5)).unwrap();
@@ -230,6 +239,7 @@ fn frames_are_validated() {
 
 #[test]
 fn live_view_shows_the_frame_and_keeps_the_image_open() {
+    let _sockets = sockets();
     let (addr, rx) = viewer();
     let (warn, seen) = warnings();
     let live = LiveView::start(options(addr), warn).unwrap();
@@ -265,7 +275,11 @@ fn a_dead_viewer_costs_one_warning_and_never_blocks() {
 
 #[test]
 fn a_viewer_started_late_is_reconnected() {
-    let addr = dead_address();
+    let _sockets = sockets();
+    let addr = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap();
     let (warn, seen) = warnings();
     let mut o = options(addr);
     o.retry_interval = Some(Duration::ZERO);
@@ -287,6 +301,7 @@ fn a_viewer_started_late_is_reconnected() {
 
 #[test]
 fn a_stalled_viewer_gets_the_latest_frame_and_the_caller_never_waits() {
+    let _sockets = sockets();
     // Frames of 2048x1024x3 floats (25 MB) cannot fit in loopback socket
     // buffers (a few MB), so the worker stalls on frame 1 while nobody reads.
     let l = TcpListener::bind("127.0.0.1:0").unwrap();
