@@ -34,9 +34,10 @@ medians are printed, so load from other processes skews both sides alike):
   estimators and not the models: candela's coated floor is ~7.5 % darker than
   pbrt-v4's by design (it matches pbrt-v4's layered random walk, which
   pbrt-v4's stochastic f() overestimates). pbrt-v4 has no time limit, so its
-  iteration count is calibrated to the same time. Target: candela's relMSE
-  <= 0.7 x pbrt-v4's. A second line gives both without the worst 0.1 % of
-  pixels (`candela diff`): candela's photons carry the adjoint shading-normal
+  iteration count is calibrated to the same time. Both render --reps times
+  with seeds 1, 2, ... (pbrt-v4's --seed), and the medians are compared.
+  Target: candela's relMSE <= 0.7 x pbrt-v4's. Lines "without the worst 0.1 %
+  of pixels" give both (`candela diff`): candela's photons carry the adjoint shading-normal
   correction [Veach 1997, eq. 5.19] that pbrt-v4 leaves out, which keeps them
   consistent with camera paths on smooth-shaded glass but gives rare photons
   hundreds of times the usual power, and one of them can carry most of the
@@ -82,8 +83,8 @@ def candela_cmd(scene, spp, threads, out, extra=()):
     return [BIN, "render", scene, "--spp", str(spp), "--nthreads", str(threads), "--outfile", out, "--quiet", *extra]
 
 
-def pbrt_cmd(pbrt, scene, spp, threads, out):
-    return [pbrt, "--spp", str(spp), "--nthreads", str(threads), "--outfile", out, "--quiet", scene]
+def pbrt_cmd(pbrt, scene, spp, threads, out, extra=()):
+    return [pbrt, "--spp", str(spp), "--nthreads", str(threads), "--outfile", out, "--quiet", *extra, scene]
 
 
 def alternate(runs, reps):
@@ -165,30 +166,42 @@ def candela_reference(ref_spp):
     return ref
 
 
-def case_sppm(pbrt, seconds, ref_spp):
+def case_sppm(pbrt, seconds, ref_spp, reps):
     if not pbrt:
         print("sppm: skipped, $PBRT_V4 is not set")
         return
     ref = candela_reference(ref_spp)
     s = variant(CAUSTIC, "sppm", SPPM)
+    # errors[label][renderer] over the reps (seeds 1..reps), trimmed or not.
+    errors = {(label, trim): {"candela": [], "pbrt": []}
+              for label in ("image", "caustic") for trim in (False, True)}
     try:
         c_out, p_out = os.path.join(OUT, "sppm-candela.exr"), os.path.join(OUT, "sppm-pbrt.exr")
-        tc = timed(candela_cmd(s, 10**6, 2, c_out, ["--time-limit", str(seconds)]))
-        # pbrt-v4: time a short run, then give it the iterations that fill `seconds`.
+        # pbrt-v4 has no time limit: time a short run, then give it the
+        # iterations that fill `seconds` (calibrated once, used for every rep).
         t4 = timed(pbrt_cmd(pbrt, s, 4, 2, p_out))
         t8 = timed(pbrt_cmd(pbrt, s, 8, 2, p_out))
         per = max((t8 - t4) / 4, 1e-3)
         n = max(1, round((seconds - (t4 - 4 * per)) / per))
-        tp = timed(pbrt_cmd(pbrt, s, n, 2, p_out))
+        for rep in range(reps):
+            seed = str(rep + 1)
+            tc = timed(candela_cmd(s, 10**6, 2, c_out, ["--time-limit", str(seconds), "--seed", seed]))
+            tp = timed(pbrt_cmd(pbrt, s, n, 2, p_out, ["--seed", seed]))
+            print(f"sppm caustic-glass seed {seed}: candela {tc:.1f} s, pbrt-v4 {tp:.1f} s ({n} iterations)")
+            for region, label in ((None, "image"), (CAUSTIC_REGION, "caustic")):
+                for trim in (False, True):
+                    e = errors[(label, trim)]
+                    e["candela"].append(rel_mse(c_out, ref, region, trim))
+                    e["pbrt"].append(rel_mse(p_out, CAUSTIC_REF_PBRT, region, trim))
     finally:
         os.unlink(s)
-    for region, label in ((None, "image"), (CAUSTIC_REGION, "caustic")):
-        ec, ep = rel_mse(c_out, ref, region), rel_mse(p_out, CAUSTIC_REF_PBRT, region)
-        print(f"sppm caustic-glass {label:<8} relMSE candela {ec:.4f} ({tc:.1f} s)  pbrt-v4 {ep:.4f} "
-              f"({tp:.1f} s, {n} iterations)   ratio {ec / ep:5.3f}  (target 0.7)")
-        tc_, tp_ = rel_mse(c_out, ref, region, True), rel_mse(p_out, CAUSTIC_REF_PBRT, region, True)
-        print(f"sppm caustic-glass {label:<8} without the worst 0.1 % of pixels: candela {tc_:.4f}  "
-              f"pbrt-v4 {tp_:.4f}   ratio {tc_ / tp_:5.3f}")
+    for (label, trim), e in errors.items():
+        ec, ep = statistics.median(e["candela"]), statistics.median(e["pbrt"])
+        what = f"{label:<8} relMSE" + (" without the worst 0.1 % of pixels" if trim else "")
+        each = ", ".join(f"{c:.4f}/{p:.4f}" for c, p in zip(e["candela"], e["pbrt"]))
+        target = "" if trim else "  (target 0.7)"
+        print(f"sppm caustic-glass {what}: candela {ec:.4f}  pbrt-v4 {ep:.4f}   ratio {ec / ep:5.3f}{target}"
+              f"   [candela/pbrt-v4 per seed: {each}]")
 
 
 def case_scaling(reps):
@@ -225,7 +238,7 @@ def main():
     if "mitsuba" in cases:
         case_mitsuba(a.reps)
     if "sppm" in cases:
-        case_sppm(pbrt, a.seconds, a.ref_spp)
+        case_sppm(pbrt, a.seconds, a.ref_spp, a.reps)
     if "scaling" in cases:
         case_scaling(a.reps)
     with open("/proc/loadavg") as f:
