@@ -285,6 +285,16 @@ fn film_sampler_and_integrator_settings_must_be_in_their_domain() {
                 at: "\"integer pixelsamples\"",
                 msg: "Sampler \"independent\" \"pixelsamples\" must be at least 1, found 0".into(),
             },
+            Case {
+                text: scene(FILM, "", "", "Shape \"sphere\"").replace(
+                    "Sampler \"independent\"",
+                    "Sampler \"halton\" \"string randomization\" \"fastowen\"",
+                ),
+                at: "\"string randomization\"",
+                msg: "Sampler \"halton\" \"randomization\" \"fastowen\" is not supported by the \
+                      Halton sampler (supported: none, permutedigits, owen)"
+                    .into(),
+            },
             opts(
                 "Integrator \"path\" \"integer maxdepth\" [-1]",
                 "\"integer maxdepth\"",

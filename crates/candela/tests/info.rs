@@ -20,7 +20,7 @@ fn tmpdir(name: &str) -> PathBuf {
 const SCENE: &str = r#"LookAt 0 0 -3  0 0 0  0 1 0
 Camera "perspective" "float fov" [45]
 Film "rgb" "integer xresolution" [32] "integer yresolution" [24] "string filename" "never.exr"
-Sampler "halton" "integer pixelsamples" [4]
+Sampler "pmj02bn" "integer pixelsamples" [4]
 Integrator "path" "integer maxdepth" [7]
 WorldBegin
 LightSource "point" "point3 from" [0 2 -2] "rgb I" [5 5 5]
@@ -61,7 +61,7 @@ fn info_prints_counts_settings_and_warnings_and_renders_nothing() {
     for want in [
         "camera      perspective, fov 45°",
         "film        rgb 32×24 → never.exr",
-        "sampler     halton (rendered as paddedsobol), 4 spp",
+        "sampler     pmj02bn (rendered as paddedsobol), 4 spp",
         "integrator  path, maxdepth 7",
         "shapes      3 (disk 1, sphere 1, trianglemesh 1)",
         "primitives  4 (disk 1, sphere 1, triangle 2)",
@@ -70,7 +70,7 @@ fn info_prints_counts_settings_and_warnings_and_renders_nothing() {
         "materials   3 (conductor 1, dielectric 1, diffuse 1)",
         "textures    2 (checkerboard 1, fbm 1)",
         "warnings    3",
-        "s.pbrt:4:1: sampler \"halton\" is not implemented",
+        "s.pbrt:4:1: sampler \"pmj02bn\" is not implemented",
         "s.pbrt:9:1: texture \"lonely\" is not used by any material",
         "s.pbrt:12:76: unused parameter \"sparkle\" of Material \"conductor\"",
         "load        ",

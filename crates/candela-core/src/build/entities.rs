@@ -7,7 +7,7 @@ use crate::camera::{Camera, CameraParams, SphericalCamera, SphericalMapping};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{Buckets, Film, FilmKind, FilmLayout, FilmSettings, SurfaceAov, SurfaceSpace};
 use crate::math::{Transform, UVec2, Vec2};
-use crate::sampler::{Sampler, SamplerKind};
+use crate::sampler::{HaltonRandomize, HaltonSampler, Sampler, SamplerKind};
 use crate::spectrum::{ColorSpace, PixelSensor, LAMBDA_MAX, LAMBDA_MIN};
 use candela_scene::SceneDescription;
 use std::path::PathBuf;
@@ -335,10 +335,12 @@ pub fn camera(desc: &SceneDescription, film: &Film) -> Result<Camera, BuildError
     cam.map_err(|e| BuildError::at(&c.loc, e.to_string()))
 }
 
-/// The sampler; unknown pbrt samplers are substituted with a warning.
+/// The sampler for a film of `resolution` pixels; unknown pbrt samplers
+/// are substituted with a warning.
 pub fn sampler(
     desc: &SceneDescription,
     ov: &Overrides,
+    resolution: UVec2,
     warnings: &mut Vec<String>,
 ) -> Result<Sampler, BuildError> {
     let empty = super::default_entity("zsobol");
@@ -370,5 +372,28 @@ pub fn sampler(
             e.loc, e.name, kind
         ));
     }
+    if kind == SamplerKind::Halton {
+        return Ok(Sampler::Halton(HaltonSampler::new(
+            spp,
+            seed,
+            resolution,
+            halton_randomize(&ck)?,
+        )));
+    }
     Ok(Sampler::new(kind, spp, seed))
+}
+
+/// `Sampler "halton"`'s `"string randomization"` (pbrt-v4's names;
+/// `fastowen`, which pbrt-v4 refuses for Halton too, is an error).
+fn halton_randomize(ck: &Check<'_>) -> Result<HaltonRandomize, BuildError> {
+    let name = ck.params.get_string("randomization", "permutedigits")?;
+    HaltonRandomize::from_name(&name).ok_or_else(|| {
+        ck.error(
+            "randomization",
+            format!(
+                "\"{name}\" is not supported by the Halton sampler (supported: {})",
+                HaltonRandomize::NAMES
+            ),
+        )
+    })
 }

@@ -133,7 +133,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .collect();
     let (film, outfile) = entities::film(desc, ov, &mut budget)?;
     let camera = entities::camera(desc, &film)?;
-    let sampler = entities::sampler(desc, ov, &mut warnings)?;
+    let sampler = entities::sampler(desc, ov, film.resolution(), &mut warnings)?;
     let default_integrator = default_entity("volpath");
     let plan = integrators::integrator(desc, ov, &default_integrator, &mut warnings)?;
     // The first-hit illuminance sees one scattering event fewer than the

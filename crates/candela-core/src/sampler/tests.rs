@@ -2,7 +2,11 @@
 
 use super::*;
 
-const KINDS: [SamplerKind; 2] = [SamplerKind::Independent, SamplerKind::PaddedSobol];
+const KINDS: [SamplerKind; 3] = [
+    SamplerKind::Independent,
+    SamplerKind::PaddedSobol,
+    SamplerKind::Halton,
+];
 
 /// The first `dims` values (alternating 1D and 2D requests) of one pixel sample.
 fn values(s: &mut Sampler, pixel: UVec2, index: u32, dims: usize) -> Vec<f32> {
@@ -137,7 +141,11 @@ fn pbrt_names_map_to_samplers() {
         SamplerKind::from_name("paddedsobol"),
         Some((SamplerKind::PaddedSobol, true))
     );
-    for n in ["zsobol", "sobol", "halton", "pmj02bn", "stratified"] {
+    assert_eq!(
+        SamplerKind::from_name("halton"),
+        Some((SamplerKind::Halton, true))
+    );
+    for n in ["zsobol", "sobol", "pmj02bn", "stratified"] {
         assert_eq!(
             SamplerKind::from_name(n),
             Some((SamplerKind::PaddedSobol, false))
