@@ -102,21 +102,58 @@ fn digits(b: u32) -> u32 {
     n
 }
 
-/// `v / b^n` as a sample in [0, 1).
-fn to_unit(v: u64, b: u32, n: u32) -> f32 {
-    let scale = (b as f64).powi(n as i32);
+/// A prime base, its digit count ([`digits`]) and b^n (exact in f64).
+#[derive(Debug)]
+struct Base {
+    b: u64,
+    n: u32,
+    scale: f64,
+}
+
+/// The bases of all dimensions, computed once.
+fn bases() -> &'static [Base] {
+    static BASES: OnceLock<Vec<Base>> = OnceLock::new();
+    BASES.get_or_init(|| {
+        PRIMES
+            .iter()
+            .map(|&b| {
+                let n = digits(b);
+                Base {
+                    b: u64::from(b),
+                    n,
+                    scale: (b as f64).powi(n as i32),
+                }
+            })
+            .collect()
+    })
+}
+
+/// `v / scale` as a sample in [0, 1).
+fn to_unit(v: u64, scale: f64) -> f32 {
     ((v as f64 / scale) as f32).min(ONE_MINUS_EPSILON)
+}
+
+/// The next base-`b` digit of `a` (least significant first); `a` loses it.
+#[inline]
+fn next_digit(a: &mut u64, b: u64) -> u64 {
+    if *a == 0 {
+        return 0; // Trailing zeros: no division.
+    }
+    let q = *a / b;
+    let v = *a - q * b;
+    *a = q;
+    v
 }
 
 /// The radical inverse of `a` in base `b`, unrandomised.
 fn radical_inverse(b: u32, mut a: u64) -> f32 {
-    let (mut reversed, mut n) = (0u64, 0u32);
+    let b = u64::from(b);
+    let (mut reversed, mut scale) = (0u64, 1.0f64);
     while a != 0 {
-        reversed = reversed * b as u64 + a % b as u64;
-        a /= b as u64;
-        n += 1;
+        reversed = reversed * b + next_digit(&mut a, b);
+        scale *= b as f64;
     }
-    to_unit(reversed, b, n)
+    to_unit(reversed, scale)
 }
 
 /// The index whose first `n` base-`b` digits, reversed, are `inverse`'s.
@@ -330,33 +367,27 @@ impl HaltonSampler {
     }
 
     fn sample_dimension(&self, d: usize) -> f32 {
-        let b = PRIMES[d];
+        let Base { b, n, scale } = bases()[d];
+        let (mut a, mut reversed) = (self.index, 0u64);
         match self.randomize {
-            HaltonRandomize::None => radical_inverse(b, self.index),
+            HaltonRandomize::None => return radical_inverse(b as u32, a),
             HaltonRandomize::PermuteDigits => {
                 let perm = self.permutations.of(d);
-                let (mut a, mut reversed) = (self.index, 0u64);
-                let n = perm.len() as u32 / b;
-                for k in 0..n as usize {
-                    let v = (a % b as u64) as usize;
-                    a /= b as u64;
-                    reversed = reversed * b as u64 + u64::from(perm[k * b as usize + v]);
+                for row in perm.chunks_exact(b as usize).take(n as usize) {
+                    let v = next_digit(&mut a, b);
+                    reversed = reversed * b + u64::from(row[v as usize]);
                 }
-                to_unit(reversed, b, n)
             }
             HaltonRandomize::Owen => {
                 let hash = hash_u64s(&[d as u64, self.seed, 0x6f77_656e]);
-                let (mut a, mut reversed) = (self.index, 0u64);
-                let n = digits(b);
                 for _ in 0..n {
-                    let v = (a % b as u64) as u32;
-                    a /= b as u64;
-                    let v = kensler_permute(v, b, mix_bits(hash ^ reversed) as u32);
-                    reversed = reversed * b as u64 + u64::from(v);
+                    let v = next_digit(&mut a, b) as u32;
+                    let v = kensler_permute(v, b as u32, mix_bits(hash ^ reversed) as u32);
+                    reversed = reversed * b + u64::from(v);
                 }
-                to_unit(reversed, b, n)
             }
         }
+        to_unit(reversed, scale)
     }
 }
 
