@@ -250,15 +250,12 @@ impl Permutations {
     }
 
     /// Dimension `d`'s table: digit position k's permutation of digit v at
-    /// `k·b + v`.
+    /// `k·b + v`, for the n digit positions of [`bases`].
     fn of(&self, d: usize) -> &[u16] {
         self.tables[d].get_or_init(|| {
-            let b = PRIMES[d];
-            (0..digits(b))
-                .flat_map(|k| {
-                    let h = hash_u64s(&[u64::from(b), u64::from(k), self.seed]);
-                    shuffled(b, h)
-                })
+            let Base { b, n, .. } = bases()[d];
+            (0..n)
+                .flat_map(|k| shuffled(b as u32, hash_u64s(&[b, u64::from(k), self.seed])))
                 .collect()
         })
     }
@@ -327,9 +324,9 @@ impl HaltonSampler {
         let stride = self.scales[0] * self.scales[1];
         let mut index = 0;
         if stride > 1 {
-            for i in 0..2 {
+            for (i, base) in [2, 3].into_iter().enumerate() {
                 let p = u64::from(pixel[i] % MAX_RESOLUTION);
-                let offset = inverse_radical_inverse(p, 2 + i as u64, self.exponents[i]);
+                let offset = inverse_radical_inverse(p, base, self.exponents[i]);
                 index += offset * (stride / self.scales[i]) * self.inverses[i];
             }
             index %= stride;
@@ -374,7 +371,7 @@ impl HaltonSampler {
             HaltonRandomize::None => return radical_inverse(b as u32, a),
             HaltonRandomize::PermuteDigits => {
                 let perm = self.permutations.of(d);
-                for row in perm.chunks_exact(b as usize).take(n as usize) {
+                for row in perm.chunks_exact(b as usize) {
                     let v = next_digit(&mut a, b);
                     reversed = reversed * b + u64::from(row[v as usize]);
                 }
