@@ -12,7 +12,7 @@
 //!    children and opens the largest interior one until it has eight.
 //!    Nodes hold their children's boxes quantised to bytes on a per-node
 //!    grid, conservatively ([`node`]: 96 bytes instead of 256 for full
-//!    floats). Leaves hold at most two packs.
+//!    floats). Leaves hold one pack.
 //!
 //! Why eight, and why bytes: incoherent rays over a large mesh wait on
 //! memory, one node after another, far more than they compute. On the bench
