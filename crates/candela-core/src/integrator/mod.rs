@@ -25,6 +25,7 @@ pub mod camera_walk;
 pub mod driver;
 pub mod gather;
 mod light_tracer;
+pub mod lt_weights;
 pub mod nee;
 mod path;
 pub mod photon;

@@ -163,15 +163,14 @@ pub mod variance;
 
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
+use crate::integrator::lt_weights::{Pilot, PILOT_PASSES};
 use crate::integrator::sppm::ppm_radius2;
-use crate::math::UVec2;
 use crate::sampling::hash_u64s;
 use crate::sampling::PdfSolidAngle;
 use light::LightVertex;
 use mis::DirectMerges;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, OnceLock};
-use variance::LtWeights;
+use std::sync::OnceLock;
 
 /// Memory of one stored light vertex in bytes (position, normals, BSDF,
 /// β, MIS quantities: [`LightVertex`]); an iteration stores
@@ -182,9 +181,7 @@ pub const LIGHT_VERTEX_BYTES: usize = std::mem::size_of::<LightVertex>();
 /// (the claim at build time adds its light path's 4-byte end index).
 pub const STORED_VERTEX_BYTES: usize = LIGHT_VERTEX_BYTES + merge::MERGE_BYTES;
 
-/// Memory per rendered pixel of one variance-pilot pass's estimates
-/// ([`variance`]), kept until the second pilot pass ends.
-pub const PILOT_BYTES_PER_PIXEL: usize = std::mem::size_of::<(UVec2, variance::ByLength)>();
+pub use crate::integrator::lt_weights::PILOT_BYTES_PER_PIXEL;
 
 /// Which estimator the one VCM loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -353,14 +350,9 @@ pub struct VcmIntegrator {
     /// The first iteration's radius once known (the written one, or the
     /// pilot's).
     radius0: OnceLock<f32>,
-    /// Light tracing's factors in the weights once known ([`variance`]).
-    lt_weights: OnceLock<LtWeights>,
-    /// The camera side's estimates of the pilot passes rendered so far.
-    pilot_samples: Mutex<PilotSamples>,
+    /// Light tracing's factors in the weights, and their pilot ([`variance`]).
+    pilot: Pilot,
 }
-
-/// Per pilot pass, every pixel's camera-side estimate by path length.
-type PilotSamples = [Option<Vec<(UVec2, variance::ByLength)>>; variance::PILOT_PASSES as usize];
 
 /// The buffers a pass hands to the next ([`light::Pool`]).
 #[derive(Default)]
@@ -379,8 +371,7 @@ impl VcmIntegrator {
             stored: AtomicU64::new(0),
             pools: Pools::default(),
             radius0: OnceLock::new(),
-            lt_weights: OnceLock::new(),
-            pilot_samples: Mutex::new([None, None]),
+            pilot: Pilot::default(),
         }
     }
 
@@ -480,8 +471,8 @@ impl Integrator for VcmIntegrator {
             return PassOutcome::Cancelled;
         }
         // The first passes are the variance pilot's ([`variance`]).
-        let (lt, record) = if self.variance_pilot(ctx) && pass < variance::PILOT_PASSES {
-            (&*variance::NO_LT, self.lt_weights.get().is_none())
+        let (lt, record) = if self.variance_pilot(ctx) && pass < PILOT_PASSES {
+            (&*variance::NO_LT, self.pilot.get().is_none())
         } else {
             match self.lt_weights(ctx) {
                 Some(lt) => (lt, false),
@@ -499,7 +490,7 @@ impl Integrator for VcmIntegrator {
             block.add_tile(tile);
         }
         if let Some(samples) = it.samples {
-            self.keep_pilot_samples(ctx, pass, samples);
+            self.pilot.keep(ctx.film.resolution(), pass, samples);
         }
         PassOutcome::Done
     }
