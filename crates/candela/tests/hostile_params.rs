@@ -312,6 +312,11 @@ fn film_sampler_and_integrator_settings_must_be_in_their_domain() {
                 "Integrator \"vcm\" \"ltweights\" \"power\" is unknown (known: variance, density)",
             ),
             opts(
+                "Integrator \"bdpt\" \"string ltweights\" \"balance\"",
+                "\"string ltweights\"",
+                "Integrator \"bdpt\" \"ltweights\" \"balance\" is unknown (known: variance, density)",
+            ),
+            opts(
                 "Integrator \"vcm\" \"float joinroulette\" [1.5]",
                 "\"float joinroulette\"",
                 "Integrator \"vcm\" \"joinroulette\" must be a number in [0, 1], found 1.5",

@@ -198,7 +198,7 @@ pub fn finish(
     Ok(match plan.settings {
         Settings::Path(settings) => Box::new(PathIntegrator { settings }),
         Settings::LightPath(settings) => Box::new(LightTracer { settings }),
-        Settings::Bdpt(settings) => Box::new(BdptIntegrator { settings }),
+        Settings::Bdpt(settings) => bdpt(&ck, settings, scale, budget)?,
         Settings::Sppm(mut settings) => {
             settings.radius = radius(warnings);
             let photons = photon_scale::photons(settings.photons_per_iteration, scale);
@@ -247,6 +247,19 @@ pub fn finish(
             Box::new(PhotonMapIntegrator { settings })
         }
     })
+}
+
+/// BDPT with its variance pilot's estimates claimed against `budget`.
+fn bdpt(
+    ck: &Check<'_>,
+    settings: BdptSettings,
+    scale: &SceneScale,
+    budget: &mut Budget,
+) -> Result<Box<dyn Integrator>, BuildError> {
+    if settings.variance_lt && settings.visualize.is_none() {
+        photon_scale::claim_pilot(ck, scale, budget)?;
+    }
+    Ok(Box::new(BdptIntegrator::new(settings)))
 }
 
 /// The settings of `kind` from the directive `ck`, and the BDPT strategy
@@ -350,6 +363,7 @@ fn bdpt_settings(ck: &Check<'_>, c: &Common) -> Result<BdptSettings, BuildError>
         max_depth: c.max_depth,
         regularize: c.regularize,
         visualize: (strategies || weights).then_some(Visualize { weighted: weights }),
+        variance_lt: lt_weights(ck)?,
         ..BdptSettings::default()
     })
 }
@@ -464,7 +478,7 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
         mode,
         connections,
         direct_merges: vcm_direct_merges(ck, mode)?,
-        variance_lt: vcm_lt_weights(ck)?,
+        variance_lt: lt_weights(ck)?,
         join_roulette: ck.float(
             "joinroulette",
             VcmSettings::default().join_roulette,
@@ -473,10 +487,10 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
     })
 }
 
-/// `"string ltweights"`: light tracing weighed by the camera side's
-/// variance (`variance`, the default) or by density alone (`density`)
-/// (`integrator::vcm::variance`).
-fn vcm_lt_weights(ck: &Check<'_>) -> Result<bool, BuildError> {
+/// `"string ltweights"` of `vcm` and `bdpt`: light tracing weighed by the
+/// camera side's variance (`variance`, the default) or by density alone
+/// (`density`) (`integrator::lt_weights`).
+fn lt_weights(ck: &Check<'_>) -> Result<bool, BuildError> {
     match ck.params.get_string("ltweights", "variance")?.as_str() {
         "variance" => Ok(true),
         "density" => Ok(false),

@@ -288,19 +288,30 @@ pub fn claim_vcm(
         )
         .map_err(|m| ck.error("photonsperiteration", m))?;
     if pilot {
-        budget
-            .claim(
-                scale
-                    .pixels
-                    .saturating_mul(2 * vcm::PILOT_BYTES_PER_PIXEL as u64),
-                &format!(
-                    "the variance pilot's estimates of {} pixels in two passes",
-                    scale.pixels
-                ),
-                "lower the Film's resolution or crop it, or set \"string ltweights\" \"density\"",
-            )
-            .map_err(|m| BuildError::at(ck.loc, m))?;
+        claim_pilot(ck, scale, budget)?;
     }
+    Ok(())
+}
+
+/// Claims the variance pilot's per-pixel estimates of both pilot passes
+/// (`integrator::lt_weights`), for `vcm` and `bdpt`.
+pub fn claim_pilot(
+    ck: &Check<'_>,
+    scale: &SceneScale,
+    budget: &mut Budget,
+) -> Result<(), BuildError> {
+    budget
+        .claim(
+            scale
+                .pixels
+                .saturating_mul(2 * vcm::PILOT_BYTES_PER_PIXEL as u64),
+            &format!(
+                "the variance pilot's estimates of {} pixels in two passes",
+                scale.pixels
+            ),
+            "lower the Film's resolution or crop it, or set \"string ltweights\" \"density\"",
+        )
+        .map_err(|m| BuildError::at(ck.loc, m))?;
     Ok(())
 }
 

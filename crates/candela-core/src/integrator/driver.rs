@@ -147,7 +147,8 @@ fn render_tile(
             let Some(mut cs) = camera_sample(ctx, pixel, &mut sampler) else {
                 continue;
             };
-            let l = est.li(ctx, cs.ray, &mut cs.lambda, &mut sampler, splats) * cs.ray_weight;
+            let l = est.li_pixel(ctx, pixel, cs.ray, &mut cs.lambda, &mut sampler, splats)
+                * cs.ray_weight;
             tile.add_sample(pixel, l, &cs.lambda, cs.filter_weight);
         }
     }

@@ -63,6 +63,9 @@ pub const PILOT_PASSES: u64 = 2;
 /// the only technique (c → 0).
 pub static NO_LT: LazyLock<LtWeights> = LazyLock::new(|| LtWeights::uniform(0.0));
 
+/// Weights by density alone (c = 1 everywhere).
+pub static DENSITY: LazyLock<LtWeights> = LazyLock::new(|| LtWeights::uniform(1.0));
+
 /// A camera path's estimate split by path length (scattering vertices
 /// 1..=[`LENGTHS`], the last holding all longer ones), mean over
 /// wavelengths; index 0 holds emission seen directly.

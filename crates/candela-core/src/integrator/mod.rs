@@ -46,7 +46,7 @@ pub use vcm::{Connections, VcmIntegrator, VcmMode, VcmSettings};
 
 use crate::camera::Camera;
 use crate::film::{Film, PassBlock, SplatBuffer};
-use crate::math::Ray;
+use crate::math::{Ray, UVec2};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -205,6 +205,20 @@ pub trait PixelEstimator: Send + Sync {
         sampler: &mut Sampler,
         splats: &mut SplatBuffer,
     ) -> SampledSpectrum;
+
+    /// [`PixelEstimator::li`] for a sample of `pixel`: what the driver
+    /// calls, for estimators that keep something per pixel.
+    fn li_pixel(
+        &self,
+        ctx: &RenderContext<'_>,
+        _pixel: UVec2,
+        ray: Ray,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        splats: &mut SplatBuffer,
+    ) -> SampledSpectrum {
+        self.li(ctx, ray, lambda, sampler, splats)
+    }
 
     /// True when [`PixelEstimator::li`] splats: the driver then sums the splats
     /// it records per tile into splat buffers (module doc of [`driver`]).

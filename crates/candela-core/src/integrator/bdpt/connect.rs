@@ -17,6 +17,7 @@ use super::density::{emitted, pdf_light_origin};
 use super::mis::{mis_weight, MisHeuristic, PathView};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
+use crate::integrator::lt_weights::LtWeights;
 use crate::integrator::nee::{sample_light, Receiver};
 use crate::integrator::subpath::{Vertex, VertexKind};
 use crate::light::LightType;
@@ -47,11 +48,20 @@ pub(crate) struct ConnectCtx<'a> {
     pub lambda: &'a SampledWavelengths,
     /// MIS heuristic.
     pub heuristic: MisHeuristic,
+    /// Light tracing's factors in the weights.
+    pub lt: &'a LtWeights,
+    /// Film position of the camera subpath's ray (raster units): where the
+    /// paths of strategies t ≥ 2 are seen.
+    pub p_film: Vec2,
 }
 
 impl ConnectCtx<'_> {
-    fn weight(&self, view: &PathView<'_>) -> f32 {
-        mis_weight(self.scene, self.camera, view, self.heuristic)
+    /// The MIS weight of the strategy that made `view`, seen at film
+    /// position `p_raster` (t = 1) or [`Self::p_film`].
+    pub fn weight(&self, view: &PathView<'_>, p_raster: Option<Vec2>) -> f32 {
+        let row = self.lt.row(p_raster.unwrap_or(self.p_film));
+        let c = LtWeights::at(row, (view.n() - 2) as u32);
+        mis_weight(self.scene, self.camera, view, self.heuristic, c)
     }
 }
 
@@ -68,7 +78,7 @@ pub(crate) fn connect(
         return connect_emitter(cx, cam, t);
     }
     strategy(cx, light, cam, s, t, sampler, |(c, p_raster), view| {
-        let w = cx.weight(view);
+        let w = cx.weight(view, p_raster);
         Contribution {
             unweighted: c,
             weighted: c * w,
@@ -128,7 +138,7 @@ fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Cont
             cam_end: Some(e),
         };
         out.unweighted += c;
-        out.weighted += c * cx.weight(&view);
+        out.weighted += c * cx.weight(&view, None);
     };
     if v.at_infinity() {
         for &id in cx.scene.infinite_lights() {

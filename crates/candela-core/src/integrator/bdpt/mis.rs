@@ -24,6 +24,12 @@
 //! sampled by area): the term of k = 1 is multiplied by q, and when s = 1
 //! every other term is divided by it. The module doc of
 //! [`crate::integrator::vcm::mis`] gives the reason.
+//!
+//! **Variance-aware light tracing.** The term of light tracing (k = n − 1,
+//! t = 1) in every weight of a path is multiplied by the factor c of the
+//! path's image block and length ([`crate::integrator::lt_weights`]): w_s =
+//! c_s h(p_s) / Σ_k c_k h(p_k), c_k = 1 for every other strategy. Any c
+//! that is a function of the path keeps the weights summing to one.
 
 use super::density::{pdf, pdf_light_origin, pdf_scatter_pair};
 use crate::bsdf::TransportMode;
@@ -308,28 +314,27 @@ pub(crate) fn weight_from_densities(
     d: &PathDensities,
     s: usize,
     h: MisHeuristic,
+    c_lt: f32,
 ) -> f32 {
     let n = d.delta.len();
     let remap0 = |p: f32| if p != 0.0 { p } else { 1.0 };
-    let mut sum = 1.0f32;
+    let c = |k: usize| lt_factor(k, n, c_lt);
+    let mut total = c(s);
     let mut r = 1.0f32;
     for k in s + 1..n {
         r *= remap0(d.p_light[k - 1]) / remap0(d.p_eye[k - 1]);
         if strategy_valid(scene, camera, x0, &d.delta, k) {
-            sum += h.apply(with_nee(r, k, s, d.nee));
+            total += c(k) * h.apply(with_nee(r, k, s, d.nee));
         }
     }
     r = 1.0;
     for k in (0..s).rev() {
         r *= remap0(d.p_eye[k]) / remap0(d.p_light[k]);
         if strategy_valid(scene, camera, x0, &d.delta, k) {
-            sum += h.apply(with_nee(r, k, s, d.nee));
+            total += c(k) * h.apply(with_nee(r, k, s, d.nee));
         }
     }
-    if !sum.is_finite() {
-        return 0.0;
-    }
-    1.0 / sum
+    weight_of(c(s), total)
 }
 
 /// MIS weight of the strategy that made `view`: the ratios p_k/p_s walked
@@ -339,6 +344,7 @@ pub(crate) fn mis_weight(
     camera: &Camera,
     view: &PathView<'_>,
     h: MisHeuristic,
+    c_lt: f32,
 ) -> f32 {
     let (n, s) = (view.n(), view.s);
     let j = JoinDensities::of(scene, camera, view);
@@ -347,23 +353,48 @@ pub(crate) fn mis_weight(
     let valid = |k: usize| strategies.valid(|i| is_delta(view, i), k);
     let remap0 = |p: f32| if p != 0.0 { p } else { 1.0 };
     let q = nee_factor(scene, x0, view.get(1), n, j.p_light(view, 0));
-    let mut sum = 1.0f32;
+    let c = |k: usize| lt_factor(k, n, c_lt);
+    let mut total = c(s);
     let mut r = 1.0f32;
     for k in s + 1..n {
         r *= remap0(j.p_light(view, k - 1)) / remap0(j.p_eye(view, k - 1));
         if valid(k) {
-            sum += h.apply(with_nee(r, k, s, q));
+            total += c(k) * h.apply(with_nee(r, k, s, q));
         }
     }
     r = 1.0;
     for k in (0..s).rev() {
         r *= remap0(j.p_eye(view, k)) / remap0(j.p_light(view, k));
         if valid(k) {
-            sum += h.apply(with_nee(r, k, s, q));
+            total += c(k) * h.apply(with_nee(r, k, s, q));
         }
     }
-    if !sum.is_finite() {
+    weight_of(c(s), total)
+}
+
+/// The factor of strategy k's term in a path of `n` vertices: `c_lt` for
+/// light tracing (k = n − 1, t = 1), 1 for every other (module doc).
+#[inline(always)]
+fn lt_factor(k: usize, n: usize, c_lt: f32) -> f32 {
+    if k + 1 == n {
+        c_lt
+    } else {
+        1.0
+    }
+}
+
+/// c_s h(p_s) / Σ_k c_k h(p_k) from the used strategy's factor `c_s` and
+/// `total`, the sum of every valid strategy's term relative to h(p_s)
+/// (its own, c_s, first: with c_s = 1 the same operations as without
+/// factors). With c_s = 0 (light tracing in the pilot) the weight is 0, or 1
+/// where no other strategy can make the path (the limit c → 0).
+#[inline(always)]
+fn weight_of(c_s: f32, total: f32) -> f32 {
+    if !total.is_finite() {
         return 0.0;
     }
-    1.0 / sum
+    if total == 0.0 {
+        return 1.0;
+    }
+    c_s / total
 }

@@ -18,6 +18,7 @@ use super::walk::{generate_camera_subpath, generate_light_subpath, WalkSettings}
 use crate::bsdf::TransportMode;
 use crate::build::{build, Overrides, RenderSetup};
 use crate::camera::CameraSample;
+use crate::integrator::lt_weights::DENSITY;
 use crate::integrator::nee::nee_context;
 use crate::integrator::subpath::{Vertex, VertexKind};
 use crate::math::{UVec2, Vec2};
@@ -136,10 +137,20 @@ fn brute_densities(rs: &RenderSetup, view: &PathView<'_>) -> PathDensities {
     d
 }
 
-/// w_s = p_s^β / Σ_k p_k^β with p_k = Π_{i<k} p_L[i] Π_{i≥k} p_E[i], in f64.
-fn product_weight(rs: &RenderSetup, x0: &Vertex, d: &PathDensities, s: usize, beta: i32) -> f64 {
+/// w_s = c_s p_s^β / Σ_k c_k p_k^β with p_k = Π_{i<k} p_L[i] Π_{i≥k} p_E[i]
+/// and c_k = `c_lt` for light tracing (k = n − 1), else 1, in f64; with
+/// c_s = 0 the limit c → 0 (1 if no other strategy is valid, else 0).
+fn product_weight(
+    rs: &RenderSetup,
+    x0: &Vertex,
+    d: &PathDensities,
+    s: usize,
+    beta: i32,
+    c_lt: f32,
+) -> f64 {
     let n = d.delta.len();
     let remap = |p: f32| if p != 0.0 { p as f64 } else { 1.0 };
+    let c = |k: usize| if k + 1 == n { c_lt as f64 } else { 1.0 };
     let p = |k: usize| -> f64 {
         // Strategy 1 draws x_0 by next-event estimation: p_NEE = q p_L[0].
         let q = if k == 1 { d.nee as f64 } else { 1.0 };
@@ -147,11 +158,12 @@ fn product_weight(rs: &RenderSetup, x0: &Vertex, d: &PathDensities, s: usize, be
         let e: f64 = (k..n).map(|i| remap(d.p_eye[i])).product();
         (l * e).powi(beta)
     };
-    let sum: f64 = (0..n)
-        .filter(|&k| strategy_valid(&rs.scene, &rs.camera, x0, &d.delta, k))
-        .map(p)
-        .sum();
-    p(s) / sum
+    let valid = |k: &usize| strategy_valid(&rs.scene, &rs.camera, x0, &d.delta, *k);
+    let sum: f64 = (0..n).filter(valid).map(|k| c(k) * p(k)).sum();
+    if sum == 0.0 {
+        return 1.0;
+    }
+    c(s) * p(s) / sum
 }
 
 #[derive(Default, Debug)]
@@ -212,31 +224,51 @@ fn check_densities(
     }
 }
 
+/// Light tracing's factors every path is checked with: density weights,
+/// a variance factor, and the pilot's limit c → 0.
+const LT_FACTORS: [f32; 3] = [1.0, 0.3, 0.0];
+
 /// Checks one connected path; records what it covered.
 fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut Coverage) {
-    let n = view.n();
     let used = PathDensities::of(&rs.scene, &rs.camera, view);
     let brute = brute_densities(rs, view);
     check_densities(&used, &brute, view, cov);
+    for c in LT_FACTORS {
+        check_weights(rs, view, h, &used, &brute, c);
+    }
+    record_coverage(rs, view, &brute, cov);
+}
+
+/// The weights of every strategy of `view`'s path sum to 1 with light
+/// tracing's factor `c`, and the one used is the product form's.
+fn check_weights(
+    rs: &RenderSetup,
+    view: &PathView<'_>,
+    h: MisHeuristic,
+    used: &PathDensities,
+    brute: &PathDensities,
+    c: f32,
+) {
+    let n = view.n();
     let x0 = view.get(0);
     let sum: f64 = (0..n)
         .filter(|&k| strategy_valid(&rs.scene, &rs.camera, x0, &brute.delta, k))
-        .map(|k| weight_from_densities(&rs.scene, &rs.camera, x0, &brute, k, h) as f64)
+        .map(|k| weight_from_densities(&rs.scene, &rs.camera, x0, brute, k, h, c) as f64)
         .sum();
     assert!(
         (sum - 1.0).abs() < 1e-4,
-        "weights sum to {sum} (s={}, t={}, n={n})",
+        "weights sum to {sum} (s={}, t={}, n={n}, c={c})",
         view.s,
         view.t
     );
-    let w = weight_from_densities(&rs.scene, &rs.camera, x0, &used, view.s, h);
+    let w = weight_from_densities(&rs.scene, &rs.camera, x0, used, view.s, h, c);
     // The renderer reads the densities in place instead of gathering them:
     // the same operations in the same order, so the same bits.
-    let in_place = mis_weight(&rs.scene, &rs.camera, view, h);
+    let in_place = mis_weight(&rs.scene, &rs.camera, view, h, c);
     assert_eq!(
         in_place.to_bits(),
         w.to_bits(),
-        "in-place weight {in_place} vs gathered {w} (s={}, t={})",
+        "in-place weight {in_place} vs gathered {w} (s={}, t={}, c={c})",
         view.s,
         view.t
     );
@@ -248,13 +280,24 @@ fn check_view(rs: &RenderSetup, view: &PathView<'_>, h: MisHeuristic, cov: &mut 
     // in a corner, vertices 1e-3 apart, differs by 0.4 % at s = 6).
     let w = w as f64;
     let beta = if h == MisHeuristic::Power { 2 } else { 1 };
-    let wb = product_weight(rs, x0, &used, view.s, beta);
+    let wb = product_weight(rs, x0, used, view.s, beta, c);
     assert!(
         (w - wb).abs() <= 1e-4 * wb.max(1e-6),
-        "weight {w} vs product form {wb} (s={}, t={})",
+        "weight {w} vs product form {wb} (s={}, t={}, c={c})",
         view.s,
         view.t
     );
+}
+
+/// Counts what `view`'s path covers.
+fn record_coverage(
+    rs: &RenderSetup,
+    view: &PathView<'_>,
+    brute: &PathDensities,
+    cov: &mut Coverage,
+) {
+    let n = view.n();
+    let x0 = view.get(0);
     cov.paths_by_length[n.min(7)] += 1;
     if brute.delta.iter().any(|&d| d) {
         cov.with_specular += 1;
@@ -338,6 +381,8 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
             camera: &rs.camera,
             lambda: &lambda,
             heuristic: h,
+            lt: &DENSITY,
+            p_film: Vec2::ZERO,
         };
         for t in 1..=cam.len() {
             for s in 0..=light.len() {

@@ -14,6 +14,7 @@
 use super::BdptIntegrator;
 use crate::film::{PassBlock, SplatBuffer};
 use crate::integrator::driver::{camera_sample, tiles};
+use crate::integrator::lt_weights::DENSITY;
 use crate::integrator::{PassOutcome, RenderContext};
 use crate::math::{UVec2, Vec2};
 use rayon::prelude::*;
@@ -94,6 +95,7 @@ pub(super) fn render_pass(
                             cs.ray,
                             &mut cs.lambda,
                             &mut sampler,
+                            &DENSITY,
                             |s, t, c, lambda| {
                                 let p = c.p_raster.unwrap_or(centre);
                                 main.add(p, c.weighted * w, lambda);
