@@ -278,7 +278,7 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
 /// blocks raise a little, would). Each pixel's s² has K − 1 = 7 degrees of
 /// freedom, a relative standard deviation of √(2/7) ≈ 0.53, so the sum over
 /// the ~1000 pixels has about 0.025 and the ratio of two sums about 0.035.
-/// Measured 0.594; the bound 0.8 is some 10σ above that and 6σ below 1
+/// Measured 0.63; the bound 0.8 is some 7σ above that and 6σ below 1
 /// (factors that change nothing).
 #[test]
 fn bdpt_variance_aware_light_tracing_weights_lower_direct_light_noise_without_bias() {

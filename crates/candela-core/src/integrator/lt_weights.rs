@@ -23,9 +23,12 @@
 //! the factors are; they only move work between techniques. (Multiplying
 //! by c² instead, as the densities are raised, was measured worse in `vcm`.)
 //!
-//! **The pilot.** Passes 0 and 1 are rendered with c = 0: light tracing
-//! keeps only the paths no other technique makes (the limit c → 0 of its
-//! weight), and the camera's techniques alone estimate the rest. Each of
+//! **The pilot.** Passes 0 and 1 measure the camera's techniques weighed
+//! with c = 0: light tracing keeping only the paths no other technique
+//! makes (the limit c → 0 of its weight), the camera's techniques alone
+//! estimate the rest. (`vcm` renders those passes with c = 0; `bdpt` renders
+//! them with c = 1 and weighs each camera-side contribution a second time
+//! with c = 0 for the record, see its module doc.) Each of
 //! the two passes gives every pixel, per path length k, a sample x of the
 //! camera side's estimate (mean over the pass's wavelengths). With the two
 //! samples x₁, x₂ of each pixel, (x₁ − x₂)²/2 estimates the pixel's

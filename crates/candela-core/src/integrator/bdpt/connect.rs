@@ -36,6 +36,10 @@ pub(crate) struct Contribution {
     pub weighted: SampledSpectrum,
     /// Raster position for t = 1 (splat), `None` for the current pixel.
     pub p_raster: Option<Vec2>,
+    /// With [`ConnectCtx::pilot`], the contribution weighted as in the
+    /// limit c → 0 of light tracing's factor (what the variance pilot
+    /// measures, [`crate::integrator::lt_weights`]); else zero.
+    pub pilot: SampledSpectrum,
 }
 
 /// What every connection needs.
@@ -53,15 +57,25 @@ pub(crate) struct ConnectCtx<'a> {
     /// Film position of the camera subpath's ray (raster units): where the
     /// paths of strategies t ≥ 2 are seen.
     pub p_film: Vec2,
+    /// Also weigh every contribution with light tracing's factor 0
+    /// ([`Contribution::pilot`]).
+    pub pilot: bool,
 }
 
 impl ConnectCtx<'_> {
-    /// The MIS weight of the strategy that made `view`, seen at film
-    /// position `p_raster` (t = 1) or [`Self::p_film`].
-    pub fn weight(&self, view: &PathView<'_>, p_raster: Option<Vec2>) -> f32 {
+    /// The MIS weights of the strategy that made `view`, seen at film
+    /// position `p_raster` (t = 1) or [`Self::p_film`]: with light tracing's
+    /// factor there, and with factor 0 when [`Self::pilot`] (else 0).
+    pub fn weights(&self, view: &PathView<'_>, p_raster: Option<Vec2>) -> (f32, f32) {
         let row = self.lt.row(p_raster.unwrap_or(self.p_film));
         let c = LtWeights::at(row, (view.n() - 2) as u32);
-        mis_weight(self.scene, self.camera, view, self.heuristic, c)
+        let w = mis_weight(self.scene, self.camera, view, self.heuristic, c);
+        let w0 = if self.pilot {
+            mis_weight(self.scene, self.camera, view, self.heuristic, 0.0)
+        } else {
+            0.0
+        };
+        (w, w0)
     }
 }
 
@@ -78,11 +92,12 @@ pub(crate) fn connect(
         return connect_emitter(cx, cam, t);
     }
     strategy(cx, light, cam, s, t, sampler, |(c, p_raster), view| {
-        let w = cx.weight(view, p_raster);
+        let (w, w0) = cx.weights(view, p_raster);
         Contribution {
             unweighted: c,
             weighted: c * w,
             p_raster,
+            pilot: c * w0,
         }
     })
 }
@@ -122,6 +137,7 @@ fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Cont
         unweighted: SampledSpectrum::zero(),
         weighted: SampledSpectrum::zero(),
         p_raster: None,
+        pilot: SampledSpectrum::zero(),
     };
     let mut add = |e: Vertex| {
         let le = emitted(cx.scene, &e, e.wo, cx.lambda);
@@ -138,7 +154,9 @@ fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Cont
             cam_end: Some(e),
         };
         out.unweighted += c;
-        out.weighted += c * cx.weight(&view, None);
+        let (w, w0) = cx.weights(&view, None);
+        out.weighted += c * w;
+        out.pilot += c * w0;
     };
     if v.at_infinity() {
         for &id in cx.scene.infinite_lights() {

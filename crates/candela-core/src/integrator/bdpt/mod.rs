@@ -20,19 +20,24 @@
 //!
 //! **Light tracing's weights** (`"string ltweights"`): `variance` (the
 //! default) multiplies light tracing's term in every weight by the factor c
-//! of the path's image block and length that passes 0 and 1, rendered with
-//! c = 0, measured ([`crate::integrator::lt_weights`], as `vcm` does);
-//! `density` is pbrt-v4's weighting by the densities alone (the same bits
-//! as before the factors existed). Both are unbiased; `visualizestrategies`
-//! and `visualizeweights` use `density`. Measured at half resolution
-//! (relMSE against long references, seeds 1–3 unless said): the Cornell box
-//! at 64 spp 0.001595, 0.001591, 0.001570 against 0.001656, 0.001664,
-//! 0.001656 (−4 to −5 %; at 32 spp −0.5 to −3 %, the pilot's two passes being
-//! a larger share); its direct light alone (`maxdepth 1`, 32 spp, seeds 1–2,
-//! against 2048 spp of `path`) 0.000785, 0.000784 against 0.001348, 0.001364
-//! (−42 %); caustic-glass, whose caustic light tracing carries (c near 1 there,
-//! and the pilot's passes without it are noisier), +0.8 % at 64 spp and +2 %
-//! at 16 (seeds 1–2).
+//! of the path's image block and length that passes 0 and 1 measure
+//! ([`crate::integrator::lt_weights`], as `vcm` does); `density` is pbrt-v4's
+//! weighting by the densities alone (the same bits as before the factors
+//! existed). Both are unbiased; `visualizestrategies` and `visualizeweights`
+//! use `density`. The two pilot passes go into the image with `density`
+//! weights, and each of their camera-side contributions is weighed a second
+//! time, with c = 0, for what they record: two MIS weights per strategy in
+//! two passes, and pilot passes as good as `density`'s instead of the
+//! noisier c = 0 images `vcm`'s pilot adds (light tracing kept only where it
+//! is the only technique). Measured at half resolution (relMSE against long
+//! references): the Cornell box at 64 spp 0.001563, 0.001554, 0.001543
+//! against 0.001656, 0.001664, 0.001656 (seeds 1–3, −6 to −7 %), at 32 spp
+//! −5 to −7 % (with the pilot's own images at c = 0 it was −0.5 to −3 %
+//! there); its direct light alone (`maxdepth 1`, 32 spp, seeds 1–2, against
+//! 2048 spp of `path`) 0.000803, 0.000817 against 0.001348, 0.001364
+//! (−40 %); caustic-glass, whose caustic light tracing carries (c near 1
+//! there), +0.4 % at 16 spp and +0.5 % at 64 (seeds 1–2; +2 % and +0.8 %
+//! with c = 0 pilot images).
 
 mod connect;
 mod density;
@@ -51,7 +56,7 @@ use super::{
 };
 use crate::film::{PassBlock, SplatBuffer};
 use crate::integrator::lt_weights::{
-    ByLength, LtWeights, Pilot, PilotSamples, LENGTHS, NO_LT, PILOT_PASSES,
+    ByLength, LtWeights, Pilot, PilotSamples, DENSITY, LENGTHS, PILOT_PASSES,
 };
 use crate::integrator::subpath::Vertex;
 use crate::math::{Ray, UVec2, Vec2};
@@ -132,10 +137,11 @@ impl Integrator for BdptIntegrator {
         if let Some(v) = &self.settings.visualize {
             return visualize::render_pass(self, v, ctx, pass, block);
         }
-        // The first passes are the pilot's, with c = 0 (module doc).
+        // The first passes are the pilot's: weights by density (c = 1) in
+        // the image, c = 0 in what they record (module doc).
         let pilot = self.variance_pilot(ctx) && pass < PILOT_PASSES;
         let lt = if pilot {
-            &*NO_LT
+            &*DENSITY
         } else {
             match self.lt_weights(ctx) {
                 Some(lt) => lt,
@@ -150,6 +156,14 @@ impl Integrator for BdptIntegrator {
         }
         out
     }
+}
+
+/// Light tracing's factors a sample is weighted with, and whether it also
+/// records its factor-0 weighting for the pilot.
+#[derive(Clone, Copy)]
+struct Weights<'a> {
+    lt: &'a LtWeights,
+    pilot: bool,
 }
 
 /// One pass's estimator: the weights it uses, and the camera side's
@@ -198,7 +212,9 @@ impl PixelEstimator for PassEstimator<'_> {
         sampler: &mut Sampler,
         splats: &mut SplatBuffer,
     ) -> SampledSpectrum {
-        self.bdpt.li(ctx, ray, lambda, sampler, splats, self.lt).0
+        self.bdpt
+            .li(ctx, ray, lambda, sampler, splats, self.lt, false)
+            .0
     }
 
     fn li_pixel(
@@ -210,7 +226,10 @@ impl PixelEstimator for PassEstimator<'_> {
         sampler: &mut Sampler,
         splats: &mut SplatBuffer,
     ) -> SampledSpectrum {
-        let (l, x) = self.bdpt.li(ctx, ray, lambda, sampler, splats, self.lt);
+        let record = self.record.is_some();
+        let (l, x) = self
+            .bdpt
+            .li(ctx, ray, lambda, sampler, splats, self.lt, record);
         if let Some(Ok(mut kept)) = self.record.as_ref().map(Mutex::lock) {
             kept.push((pixel, x));
         }
@@ -249,7 +268,7 @@ impl BdptIntegrator {
         };
         let enabled = self.variance_pilot(ctx);
         self.pilot.weights(ctx.film.resolution(), enabled, |pass| {
-            let est = PassEstimator::new(self, &NO_LT, true);
+            let est = PassEstimator::new(self, &DENSITY, true);
             let mut scratch = ctx.film.block();
             match driver::render_pixels(&est, &quiet, pass, &mut scratch) {
                 PassOutcome::Done => est.samples(ctx),
@@ -258,8 +277,9 @@ impl BdptIntegrator {
         })
     }
 
-    /// One camera ray's estimate (the t = 1 strategies splatted) and its
-    /// camera-side part by path length, mean over the wavelengths.
+    /// One camera ray's estimate (the t = 1 strategies splatted) and, when
+    /// `pilot`, its camera-side part by path length weighted with light
+    /// tracing's factor 0, mean over the wavelengths.
     fn li(
         &self,
         ctx: &RenderContext<'_>,
@@ -268,18 +288,25 @@ impl BdptIntegrator {
         sampler: &mut Sampler,
         splats: &mut SplatBuffer,
         lt: &LtWeights,
+        pilot: bool,
     ) -> (SampledSpectrum, ByLength) {
         let mut l = SampledSpectrum::zero();
         let mut x: ByLength = [0.0; LENGTHS + 1];
-        self.sample_strategies(ctx, ray, lambda, sampler, lt, |s, t, c, lambda| {
-            match c.p_raster {
+        self.sample_strategies(
+            ctx,
+            ray,
+            lambda,
+            sampler,
+            lt,
+            pilot,
+            |s, t, c, lambda| match c.p_raster {
                 Some(p) => splats.add(p, c.weighted, lambda),
                 None => {
                     l += c.weighted;
-                    x[(s + t - 2).min(LENGTHS)] += c.weighted.average();
+                    x[(s + t - 2).min(LENGTHS)] += c.pilot.average();
                 }
-            }
-        });
+            },
+        );
         (l, x)
     }
 }
@@ -294,11 +321,13 @@ impl BdptIntegrator {
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         lt: &LtWeights,
+        pilot: bool,
         mut visit: impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
     ) {
         SCRATCH.with(|cell| {
             let mut scratch = cell.borrow_mut();
-            self.sample_strategies_in(ctx, ray, lambda, sampler, lt, &mut scratch, &mut visit);
+            let w = Weights { lt, pilot };
+            self.sample_strategies_in(ctx, ray, lambda, sampler, w, &mut scratch, &mut visit);
         });
     }
 
@@ -310,7 +339,7 @@ impl BdptIntegrator {
         ray: Ray,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
-        lt: &LtWeights,
+        weights: Weights<'_>,
         scratch: &mut Scratch,
         visit: &mut impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
     ) {
@@ -339,8 +368,9 @@ impl BdptIntegrator {
             camera: ctx.camera,
             lambda: &lambda,
             heuristic: self.settings.heuristic,
-            lt,
+            lt: weights.lt,
             p_film,
+            pilot: weights.pilot,
         };
         // s = 1 resamples the light (`connect_light`) and does not use the
         // light subpath, so it runs even when that subpath is empty because

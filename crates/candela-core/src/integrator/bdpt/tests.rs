@@ -383,6 +383,7 @@ fn run(world: &str, h: MisHeuristic, iterations: u32) -> Coverage {
             heuristic: h,
             lt: &DENSITY,
             p_film: Vec2::ZERO,
+            pilot: false,
         };
         for t in 1..=cam.len() {
             for s in 0..=light.len() {

@@ -96,6 +96,7 @@ pub(super) fn render_pass(
                             &mut cs.lambda,
                             &mut sampler,
                             &DENSITY,
+                            false,
                             |s, t, c, lambda| {
                                 let p = c.p_raster.unwrap_or(centre);
                                 main.add(p, c.weighted * w, lambda);
