@@ -149,9 +149,9 @@ impl Integrator for BdptIntegrator {
             }
         };
         let record = pilot && self.pilot.get().is_none();
-        let est = PassEstimator::new(self, lt, record);
+        let est = PassEstimator::new(ctx, self, lt, record);
         let out = driver::render_pixels(&est, ctx, pass, block);
-        if let (PassOutcome::Done, Some(samples)) = (&out, est.samples(ctx)) {
+        if let (PassOutcome::Done, Some(samples)) = (&out, est.samples()) {
             self.pilot.keep(ctx.film.resolution(), pass, samples);
         }
         out
@@ -171,35 +171,58 @@ struct Weights<'a> {
 struct PassEstimator<'a> {
     bdpt: &'a BdptIntegrator,
     lt: &'a LtWeights,
-    record: Option<Mutex<PilotSamples>>,
+    record: Option<Recorder>,
 }
 
-impl<'a> PassEstimator<'a> {
-    fn new(bdpt: &'a BdptIntegrator, lt: &'a LtWeights, record: bool) -> Self {
+/// Every pixel's camera-side estimate by path length, in the film's row
+/// order (0 where a pixel made no camera ray), as both pilot passes must
+/// list them; written in place, so a pass holds one such list.
+struct Recorder {
+    lo: UVec2,
+    width: usize,
+    samples: Mutex<PilotSamples>,
+}
+
+impl Recorder {
+    fn new(ctx: &RenderContext<'_>) -> Self {
+        let (lo, hi) = ctx.film.pixel_bounds();
+        let samples = (lo.y..hi.y)
+            .flat_map(|y| (lo.x..hi.x).map(move |x| (UVec2::new(x, y), [0.0; LENGTHS + 1])))
+            .collect();
         Self {
-            bdpt,
-            lt,
-            record: record.then(Mutex::default),
+            lo,
+            width: (hi.x - lo.x) as usize,
+            samples: Mutex::new(samples),
         }
     }
 
-    /// The recorded estimates, one per pixel of the film in row order (0
-    /// where a pixel made no camera ray), as both pilot passes must list
-    /// them.
-    fn samples(&self, ctx: &RenderContext<'_>) -> Option<PilotSamples> {
-        let kept = self.record.as_ref()?.lock().ok()?;
-        let (lo, hi) = ctx.film.pixel_bounds();
-        let w = (hi.x - lo.x) as usize;
-        let mut all: PilotSamples = (lo.y..hi.y)
-            .flat_map(|y| (lo.x..hi.x).map(move |x| (UVec2::new(x, y), [0.0; LENGTHS + 1])))
-            .collect();
-        for (p, x) in kept.iter() {
-            let i = (p.y - lo.y) as usize * w + (p.x - lo.x) as usize;
-            if let Some(slot) = all.get_mut(i) {
-                slot.1 = *x;
+    fn set(&self, pixel: UVec2, x: ByLength) {
+        let i = (pixel.y - self.lo.y) as usize * self.width + (pixel.x - self.lo.x) as usize;
+        if let Ok(mut s) = self.samples.lock() {
+            if let Some(slot) = s.get_mut(i) {
+                slot.1 = x;
             }
         }
-        Some(all)
+    }
+}
+
+impl<'a> PassEstimator<'a> {
+    fn new(
+        ctx: &RenderContext<'_>,
+        bdpt: &'a BdptIntegrator,
+        lt: &'a LtWeights,
+        record: bool,
+    ) -> Self {
+        Self {
+            bdpt,
+            lt,
+            record: record.then(|| Recorder::new(ctx)),
+        }
+    }
+
+    /// The recorded estimates ([`Recorder`]), if recording.
+    fn samples(self) -> Option<PilotSamples> {
+        self.record?.samples.into_inner().ok()
     }
 }
 
@@ -230,8 +253,8 @@ impl PixelEstimator for PassEstimator<'_> {
         let (l, x) = self
             .bdpt
             .li(ctx, ray, lambda, sampler, splats, self.lt, record);
-        if let Some(Ok(mut kept)) = self.record.as_ref().map(Mutex::lock) {
-            kept.push((pixel, x));
+        if let Some(r) = &self.record {
+            r.set(pixel, x);
         }
         l
     }
@@ -268,10 +291,10 @@ impl BdptIntegrator {
         };
         let enabled = self.variance_pilot(ctx);
         self.pilot.weights(ctx.film.resolution(), enabled, |pass| {
-            let est = PassEstimator::new(self, &DENSITY, true);
+            let est = PassEstimator::new(ctx, self, &DENSITY, true);
             let mut scratch = ctx.film.block();
             match driver::render_pixels(&est, &quiet, pass, &mut scratch) {
-                PassOutcome::Done => est.samples(ctx),
+                PassOutcome::Done => est.samples(),
                 PassOutcome::Cancelled => None,
             }
         })
