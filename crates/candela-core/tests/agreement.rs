@@ -51,17 +51,11 @@ Shape "sphere" "float radius" [1]
 /// Block means of K renders, `[block][render]`.
 fn block_means(scene: &str, integrator: &str, spp: u32) -> Vec<Vec<f64>> {
     assert!(scene.contains("[32]"), "resolution override did not apply");
-    let renders: Vec<Vec<f64>> = (0..K)
-        .map(|k| {
-            let ov = Overrides {
-                spp: Some(spp),
-                seed: Some(100 + k as u64),
-                integrator: Some(integrator.into()),
-                ..Default::default()
-            };
-            let img: RgbImage = render_str(scene, &ov);
+    let renders: Vec<Vec<f64>> = renders(scene, integrator, spp)
+        .iter()
+        .map(|img| {
             assert_eq!((img.width, img.height), (RES, RES));
-            stats::block_means(&img)
+            stats::block_means(img)
         })
         .collect();
     stats::by_block(&renders)
@@ -302,7 +296,7 @@ fn bdpt_variance_aware_light_tracing_weights_lower_direct_light_noise_without_bi
     assert!(ratio < 0.8, "pixel variance {ratio:.3}× density weights'");
 }
 
-/// K renders of `scene` by `integrator` (seeds as [`block_means`]).
+/// K renders of `scene` by `integrator`, seeds 100 … 100 + K − 1.
 fn renders(scene: &str, integrator: &str, spp: u32) -> Vec<RgbImage> {
     (0..K)
         .map(|k| {

@@ -47,7 +47,9 @@
 //! every process finds the same factors, passes stay independent, and a
 //! single render pays nothing for the pilot.
 
+use crate::integrator::RenderContext;
 use crate::math::{UVec2, Vec2};
+use std::sync::atomic::AtomicU64;
 use std::sync::{LazyLock, Mutex, OnceLock};
 
 /// Side of an image block, in pixels.
@@ -93,6 +95,12 @@ impl LtWeights {
             blocks_y: 1,
             c: vec![c; LENGTHS],
         }
+    }
+
+    /// Whether the factors differ between image blocks (else [`Self::row`]
+    /// ignores its position).
+    pub fn per_block(&self) -> bool {
+        self.blocks_x * self.blocks_y > 1
     }
 
     /// The factors of the block holding film position `p_film` (raster
@@ -206,13 +214,15 @@ impl Pilot {
 
     /// The factors: known ones, `uniform(1)` when `enabled` is false, else
     /// from the pilot passes' estimates, those not rendered by this process
-    /// made now by `render(pass)` (not added to any image). `None` if that
-    /// was cancelled.
+    /// made now by `render(quiet, pass)` (not added to any image; `quiet` is
+    /// `ctx` with a work counter of its own, so the progress of the pass
+    /// being rendered counts only its own work). `None` if that was
+    /// cancelled.
     pub fn weights(
         &self,
-        resolution: UVec2,
+        ctx: &RenderContext<'_>,
         enabled: bool,
-        mut render: impl FnMut(u64) -> Option<PilotSamples>,
+        mut render: impl FnMut(&RenderContext<'_>, u64) -> Option<PilotSamples>,
     ) -> Option<&LtWeights> {
         if let Some(w) = self.weights.get() {
             return Some(w);
@@ -220,16 +230,21 @@ impl Pilot {
         if !enabled {
             return Some(self.weights.get_or_init(|| LtWeights::uniform(1.0)));
         }
+        let work = AtomicU64::new(0);
+        let quiet = RenderContext {
+            work: &work,
+            ..*ctx
+        };
         let mut kept = self.samples.lock().ok()?;
         for (pass, slot) in kept.iter_mut().enumerate() {
             if slot.is_none() {
-                *slot = Some(render(pass as u64)?);
+                *slot = Some(render(&quiet, pass as u64)?);
             }
         }
         let [Some(a), Some(b)] = &*kept else {
             return None;
         };
-        let w = LtWeights::from_pilot(resolution, a, b);
+        let w = LtWeights::from_pilot(ctx.film.resolution(), a, b);
         *kept = [None, None];
         Some(self.weights.get_or_init(|| w))
     }

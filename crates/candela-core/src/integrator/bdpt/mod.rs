@@ -64,7 +64,6 @@ use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use connect::{connect, ConnectCtx, Contribution};
 use std::cell::RefCell;
-use std::sync::atomic::AtomicU64;
 use std::sync::Mutex;
 use walk::{generate_camera_subpath, generate_light_subpath, WalkSettings};
 
@@ -283,17 +282,11 @@ impl BdptIntegrator {
     /// process did not render made now (not added to the image); 1
     /// everywhere without the pilot. `None` if cancelled.
     fn lt_weights(&self, ctx: &RenderContext<'_>) -> Option<&LtWeights> {
-        // Its own work counter: the pass's progress counts rendered samples only.
-        let work = AtomicU64::new(0);
-        let quiet = RenderContext {
-            work: &work,
-            ..*ctx
-        };
         let enabled = self.variance_pilot(ctx);
-        self.pilot.weights(ctx.film.resolution(), enabled, |pass| {
+        self.pilot.weights(ctx, enabled, |quiet, pass| {
             let est = PassEstimator::new(ctx, self, &DENSITY, true);
             let mut scratch = ctx.film.block();
-            match driver::render_pixels(&est, &quiet, pass, &mut scratch) {
+            match driver::render_pixels(&est, quiet, pass, &mut scratch) {
                 PassOutcome::Done => est.samples(),
                 PassOutcome::Cancelled => None,
             }
@@ -367,8 +360,12 @@ impl BdptIntegrator {
         visit: &mut impl FnMut(usize, usize, &Contribution, &SampledWavelengths),
     ) {
         let max_depth = self.settings.max_depth as usize;
-        // Where the camera's ray is seen on the film (light tracing's factors).
-        let p_film = ctx.camera.we(ray.o, ray.d).1.unwrap_or(Vec2::ZERO);
+        // Where the camera's ray is seen on the film, when light tracing's
+        // factors depend on it.
+        let p_film = match weights.lt.per_block() {
+            true => ctx.camera.we(ray.o, ray.d).1.unwrap_or(Vec2::ZERO),
+            false => Vec2::ZERO,
+        };
         let Scratch { cam, light } = scratch;
         let walk = |max_vertices| WalkSettings {
             max_vertices,

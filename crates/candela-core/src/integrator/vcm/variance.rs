@@ -21,7 +21,6 @@
 use super::VcmIntegrator;
 pub use crate::integrator::lt_weights::{ByLength, LtWeights, LENGTHS, NO_LT};
 use crate::integrator::RenderContext;
-use std::sync::atomic::AtomicU64;
 
 impl VcmIntegrator {
     /// Whether light tracing's factors come from the pilot: `ltweights
@@ -36,15 +35,9 @@ impl VcmIntegrator {
     /// same iteration code (not added to the image); 1 everywhere without
     /// the pilot. `None` if cancelled.
     pub(super) fn lt_weights(&self, ctx: &RenderContext<'_>) -> Option<&LtWeights> {
-        // Its own work counter: the pass's progress counts rendered paths only.
-        let work = AtomicU64::new(0);
-        let pilot = RenderContext {
-            work: &work,
-            ..*ctx
-        };
         let enabled = self.variance_pilot(ctx);
-        self.pilot.weights(ctx.film.resolution(), enabled, |pass| {
-            let it = self.iteration(&pilot, pass, &NO_LT, true)?;
+        self.pilot.weights(ctx, enabled, |quiet, pass| {
+            let it = self.iteration(quiet, pass, &NO_LT, true)?;
             self.pools.splats.give(it.splats);
             it.samples
         })
