@@ -38,25 +38,37 @@ pub fn gamma(n: i32) -> f32 {
 /// Smallest float strictly greater than `v` (for conservative bounds).
 #[inline]
 pub fn next_float_up(v: f32) -> f32 {
-    if v.is_infinite() && v > 0.0 {
-        return v;
+    // Selects, not branches (see `ray::round_away`); −0 counts as +0.
+    let z = if v == 0.0 { 0.0 } else { v };
+    let bits = z.to_bits();
+    let next = f32::from_bits(if z >= 0.0 {
+        bits.wrapping_add(1)
+    } else {
+        bits.wrapping_sub(1)
+    });
+    if v == f32::INFINITY {
+        v
+    } else {
+        next
     }
-    let v = if v == -0.0 { 0.0 } else { v };
-    let bits = v.to_bits();
-    let bits = if v >= 0.0 { bits + 1 } else { bits - 1 };
-    f32::from_bits(bits)
 }
 
 /// Largest float strictly less than `v`.
 #[inline]
 pub fn next_float_down(v: f32) -> f32 {
-    if v.is_infinite() && v < 0.0 {
-        return v;
+    // Selects, not branches (see `ray::round_away`); +0 counts as −0.
+    let z = if v == 0.0 { -0.0 } else { v };
+    let bits = z.to_bits();
+    let next = f32::from_bits(if z > 0.0 {
+        bits.wrapping_sub(1)
+    } else {
+        bits.wrapping_add(1)
+    });
+    if v == f32::NEG_INFINITY {
+        v
+    } else {
+        next
     }
-    let v = if v == 0.0 { -0.0 } else { v };
-    let bits = v.to_bits();
-    let bits = if v > 0.0 { bits - 1 } else { bits + 1 };
-    f32::from_bits(bits)
 }
 
 /// `x²`.
@@ -197,6 +209,50 @@ mod tests {
             assert!(next_float_up(v) > v);
             assert!(next_float_down(v) < v);
         }
+    }
+
+    /// The select-based versions against the definition: the adjacent float
+    /// in the ordering where −0 and +0 are one point, infinities fixed at
+    /// their own end, NaN staying NaN.
+    #[test]
+    fn next_float_is_the_adjacent_float() {
+        let specials = [
+            0.0f32,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            1.0,
+            -1.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        for &v in &specials {
+            let up = next_float_up(v);
+            let down = next_float_down(v);
+            if v == f32::INFINITY {
+                assert_eq!(up, v);
+            } else {
+                assert!(up > v, "{v}");
+                // Nothing lies strictly between: stepping back lands on v
+                // (or on the other zero).
+                assert_eq!(next_float_down(up), if v == 0.0 { -0.0 } else { v });
+            }
+            if v == f32::NEG_INFINITY {
+                assert_eq!(down, v);
+            } else {
+                assert!(down < v, "{v}");
+                assert_eq!(next_float_up(down), if v == 0.0 { 0.0 } else { v });
+            }
+        }
+        assert_eq!(next_float_up(0.0), f32::from_bits(1));
+        assert_eq!(next_float_up(-0.0), f32::from_bits(1));
+        assert_eq!(next_float_down(0.0), -f32::from_bits(1));
+        assert_eq!(next_float_up(f32::MAX), f32::INFINITY);
+        assert!(next_float_up(f32::NAN).is_nan() && next_float_down(f32::NAN).is_nan());
     }
 
     #[test]

@@ -52,15 +52,24 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     if w.dot(n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
-    }
-    po
+    let po = p + offset;
+    Vec3::from_array(std::array::from_fn(|i| round_away(po[i], offset[i])))
+}
+
+/// `x` moved one float towards the sign of `offset` (unchanged for 0):
+/// [`next_float_up`] or [`next_float_down`], chosen by selects rather than
+/// branches. The offset's sign per axis is as good as random along a path,
+/// so branches on it were mispredicted about half the time (cachegrind's
+/// branch simulation: 9 % of the path tracer's mispredicted branches).
+#[inline]
+fn round_away(x: f32, offset: f32) -> f32 {
+    let (up, down) = (next_float_up(x).to_bits(), next_float_down(x).to_bits());
+    // All-ones masks: bit operations, which compilers keep branch-free
+    // (a float `==` or `||` here still compiled to mispredicted jumps).
+    let pos = 0u32.wrapping_sub((offset > 0.0) as u32);
+    let neg = 0u32.wrapping_sub((offset < 0.0) as u32);
+    let keep = !(pos | neg);
+    f32::from_bits((up & pos) | (down & neg) | (x.to_bits() & keep))
 }
 
 /// Ray leaving a surface point in direction `d`.
@@ -75,4 +84,56 @@ pub fn spawn_ray(p: Vec3, p_error: Vec3, n: Vec3, d: Vec3) -> Ray {
 pub fn spawn_ray_to(p: Vec3, p_error: Vec3, n: Vec3, p_to: Vec3) -> Ray {
     let o = offset_ray_origin(p, p_error, n, p_to - p);
     Ray::new(o, p_to - o)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The branch-free offset equals the branching definition [pbrt-v4
+    /// `OffsetRayOrigin`] bit for bit, on every sign pattern of the normal
+    /// (zero components included), both sides, and origins at zero.
+    #[test]
+    fn offset_origin_matches_the_branching_definition() {
+        fn reference(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+            let d = n.abs().dot(p_error);
+            let mut offset = d * n;
+            if w.dot(n) < 0.0 {
+                offset = -offset;
+            }
+            let mut po = p + offset;
+            for i in 0..3 {
+                if offset[i] > 0.0 {
+                    po[i] = next_float_up(po[i]);
+                } else if offset[i] < 0.0 {
+                    po[i] = next_float_down(po[i]);
+                }
+            }
+            po
+        }
+        let comps = [-0.6f32, -0.0, 0.0, 0.8];
+        let points = [
+            Vec3::new(0.25, -3.0, 1e-30),
+            Vec3::ZERO,
+            Vec3::new(-0.0, 7.5e5, -2.0),
+        ];
+        let err = Vec3::new(1e-6, 0.0, 3e-7);
+        for &x in &comps {
+            for &y in &comps {
+                for &z in &comps {
+                    let n = Vec3::new(x, y, z);
+                    for p in points {
+                        for w in [n, -n, Vec3::X, Vec3::new(0.0, -1.0, 0.5)] {
+                            let (a, b) = (offset_ray_origin(p, err, n, w), reference(p, err, n, w));
+                            assert_eq!(
+                                a.to_array().map(f32::to_bits),
+                                b.to_array().map(f32::to_bits),
+                                "{p} {n} {w}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
