@@ -126,6 +126,12 @@ impl<F> Eye<'_, F> {
         rng: &mut R,
     ) {
         let (u1, u2) = (rng.u1(), rng.u2());
+        // Nothing to find (delta lights only): the sample is drawn all the
+        // same, so the sampler's dimensions do not depend on the scene's
+        // lights.
+        if !self.scene.has_hittable_lights() {
+            return;
+        }
         let Some(bs) = bsdf.sample_f(v.wo, u1, u2, TransportMode::Radiance, SampleFlags::ALL)
         else {
             return;

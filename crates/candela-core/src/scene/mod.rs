@@ -31,6 +31,8 @@ pub struct Scene {
     materials: Vec<Material>,
     lights: Vec<Light>,
     infinite_lights: Vec<LightId>,
+    /// Some light can be hit by a ray ([`Light::is_hittable`]).
+    hittable_lights: bool,
     /// Context-free selection: light subpaths, BDPT and VCM.
     light_sampler: LightSampler,
     /// Selection for next-event estimation at a receiver.
@@ -79,6 +81,7 @@ impl Scene {
             .filter(|&i| matches!(lights[i].light_type(), crate::light::LightType::Infinite))
             .map(|i| LightId(i as u32))
             .collect();
+        let hittable_lights = lights.iter().any(Light::is_hittable);
         let light_sampler = selection.context_free(&lights);
         let nee_sampler = selection.nee(&lights, &light_sampler);
         Self {
@@ -89,6 +92,7 @@ impl Scene {
             materials,
             lights,
             infinite_lights,
+            hittable_lights,
             light_sampler,
             nee_sampler,
             bounds,
@@ -151,6 +155,12 @@ impl Scene {
     /// Lights at infinity (seen by escaping rays).
     pub fn infinite_lights(&self) -> &[LightId] {
         &self.infinite_lights
+    }
+    /// Whether any light can be hit by a ray (an area light that is not
+    /// invisible, or a light at infinity): with none, emission is found
+    /// only by sampling the lights.
+    pub fn has_hittable_lights(&self) -> bool {
+        self.hittable_lights
     }
     /// The context-free light selection: light subpaths, and BDPT's and
     /// VCM's light sampling at camera vertices.
