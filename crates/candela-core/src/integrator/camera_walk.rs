@@ -17,7 +17,8 @@
 //!   after a non-delta scattering counts with the BSDF-sampling weight, and
 //!   where the walk ends on such a vertex (the visible point) one BSDF
 //!   sample is drawn only to look for emission at its first hit (an area
-//!   light, or the infinite lights if it escapes). Light sampling alone
+//!   light, or the infinite lights if it escapes; not traced at all when
+//!   no light can be hit). Light sampling alone
 //!   cannot find the reflection of a large light in a narrow glossy lobe (a
 //!   coated floor under a sky: salt noise that SPPM's photons, which never
 //!   estimate direct light, do not fill in). Without it (the photon map,
