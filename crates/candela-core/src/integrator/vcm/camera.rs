@@ -21,7 +21,7 @@
 
 use super::densities::light_densities;
 use super::light::{LightPaths, LightVertex, PrevVertex};
-use super::merge::MergeGrid;
+use super::merge::{MergeGrid, Photon};
 use super::mis::{thin, weight, CameraDeferred, CameraPartial, Factors, Partial};
 use super::resample::Resampler;
 use super::variance::{ByLength, LtWeights, LENGTHS};
@@ -135,9 +135,13 @@ impl VcmIntegrator {
             l: SampledSpectrum::zero(),
             by_length: [0.0; LENGTHS + 1],
         };
+        // A path of maxdepth scattering vertices may end on a light one
+        // vertex further; mode ppm limits each subpath instead, as `ppm`
+        // does (module doc of [`super`], "Depth").
+        let extra = u32::from(!self.techniques.ppm);
         let w = Walk {
             mode: TransportMode::Radiance,
-            max_depth: self.settings.max_depth + 1,
+            max_depth: self.settings.max_depth + extra,
             roulette: Some(Roulette::Bidirectional),
             regularize: self.settings.regularize,
             dispersion: Dispersion::Fold,
@@ -485,8 +489,17 @@ impl CameraVisitor<'_, '_> {
         };
         let mut sum = SampledSpectrum::zero();
         let mut by_length: ByLength = [0.0; LENGTHS + 1];
+        // The whole path has at most maxdepth scattering vertices; in mode
+        // ppm each subpath (module doc of [`super`], "Depth").
+        let too_deep = |ph: &Photon| {
+            if ppm {
+                ph.depth > max_depth
+            } else {
+                ph.depth + v.depth > max_depth + 1
+            }
+        };
         grid.for_each_within(v.p(), self.cp.radius, |ph| {
-            if ph.depth + v.depth > max_depth + 1 || (ph.depth == 1 && !merge_direct) {
+            if too_deep(ph) || (ph.depth == 1 && !merge_direct) {
                 return;
             }
             let k = v.depth + ph.depth - 1;

@@ -40,6 +40,15 @@
 //! specular and non-specular lobes lose their specular part there, as in
 //! SmallVCM), `lt` (light tracing only, light points included).
 //!
+//! **Depth.** `maxdepth` bounds the scattering vertices of the whole path
+//! (camera and light vertices together), as in `path` and `bdpt`, except in
+//! mode `ppm`, which bounds the camera path and the light path each (the
+//! camera's merge vertex at depth ≤ maxdepth, the light vertex too, no light
+//! seen beyond vertex maxdepth), as `ppm` and `sppm` do after pbrt-v4's
+//! SPPM: so mode `ppm` equals `ppm` at any depth. Through a slab of glass
+//! under a point light at `maxdepth` 8 the whole-path bound leaves vcm
+//! 1.5–2 % darker than `sppm`; at 40 they agree to 0.2 %.
+//!
 //! **Resampled connections** (`"string connections"`, `one` by default,
 //! `all` for BDPT's estimator). A camera vertex z could join every vertex
 //! y_j of its pixel's light subpath, each with a shadow ray; let X_j be the
