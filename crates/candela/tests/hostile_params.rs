@@ -325,6 +325,40 @@ fn film_sampler_and_integrator_settings_must_be_in_their_domain() {
     );
 }
 
+/// Light tracing alone (`lightpath`, vcm's mode `lt`) with a camera that
+/// light paths cannot reach (no importance function: spherical, or an
+/// orthographic pinhole) would render black; it is refused at the
+/// Integrator directive, as `lightpath` already was (vcm's mode `lt` was
+/// not: a black image and exit code 0).
+#[test]
+fn light_tracing_alone_needs_a_camera_light_paths_can_reach() {
+    // Equirectangular: the default equal-area mapping needs a square film.
+    const SPHERICAL: &str = "Camera \"spherical\" \"string mapping\" \"equirectangular\"";
+    let msg = "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function";
+    let case = |camera: &str, integrator: &str| {
+        let o = opts(integrator, "Integrator", "");
+        let text = o.text.replace("Camera \"perspective\"", camera);
+        assert_ne!(text, o.text, "camera replaced");
+        let name = integrator.split('"').nth(1).unwrap_or_default();
+        Case {
+            text,
+            at: "Integrator",
+            msg: format!("Integrator \"{name}\": {msg}"),
+        }
+    };
+    check_all(
+        "lt-camera",
+        &[
+            case(SPHERICAL, "Integrator \"lightpath\""),
+            case(
+                "Camera \"orthographic\"",
+                "Integrator \"vcm\" \"string mode\" \"lt\"",
+            ),
+            case(SPHERICAL, "Integrator \"vcm\" \"string mode\" \"lt\""),
+        ],
+    );
+}
+
 #[test]
 fn memory_hungry_settings_are_refused_before_allocating_even_by_info() {
     let over = "over the memory limit";

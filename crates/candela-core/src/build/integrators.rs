@@ -165,6 +165,22 @@ impl Planned<'_> {
     pub fn kind(&self) -> IntegratorKind {
         self.kind
     }
+
+    /// `Integrator "NAME"` at its place in the file, for errors that
+    /// refuse it (`--integrator` replaces the name).
+    pub fn what(&self) -> String {
+        format!("{}: {}", self.entity.loc, self.what)
+    }
+
+    /// Every path is light tracing's (`lightpath`, vcm's mode `lt`), so the
+    /// camera must be one that light paths can reach.
+    pub fn light_tracing_only(&self) -> bool {
+        match &self.settings {
+            Settings::LightPath(_) => true,
+            Settings::Vcm(s) => s.mode == VcmMode::Lt,
+            _ => false,
+        }
+    }
 }
 
 /// The integrator of `plan` in the built scene: SPPM and PPM get their

@@ -143,7 +143,7 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
         .with_illuminance_depth(plan.max_depth.saturating_sub(1));
     claim_film(desc, &film, &mut budget)?;
     let kind = plan.kind();
-    check_combination(kind, &film, &camera)?;
+    check_combination(&plan, &film, &camera)?;
     let (materials, names, textures_used) = materials::materials(desc, &mut warnings)?;
     let geometry::Built {
         prims,
@@ -197,16 +197,22 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
 }
 
 /// Refuses integrators that cannot render this film or camera.
-fn check_combination(kind: IntegratorKind, film: &Film, camera: &Camera) -> Result<(), BuildError> {
-    if kind == IntegratorKind::Sppm && film.layout().photometric {
+fn check_combination(
+    plan: &integrators::Planned<'_>,
+    film: &Film,
+    camera: &Camera,
+) -> Result<(), BuildError> {
+    if plan.kind() == IntegratorKind::Sppm && film.layout().photometric {
         return Err(BuildError::Other(
             "--units photometric needs independent passes for its standard errors; SPPM's iterations depend on each other (use ppm)".into(),
         ));
     }
-    if kind == IntegratorKind::LightPath && !camera.is_connectable() {
-        return Err(BuildError::Other(
-            "the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function".into(),
-        ));
+    // Light tracing alone would render black without saying why.
+    if plan.light_tracing_only() && !camera.is_connectable() {
+        return Err(BuildError::Other(format!(
+            "{}: the light tracer needs a camera that light paths can reach (perspective, or orthographic with a lens); this scene's camera has no importance function",
+            plan.what()
+        )));
     }
     Ok(())
 }
