@@ -205,7 +205,7 @@ pub fn finish(
                 &e.name,
                 r,
                 scale,
-                footprints,
+                &photon_scale::default_radius_text(plan.kind, scale),
             ));
             r
         }

@@ -44,7 +44,7 @@ use crate::film::Film;
 use crate::integrator::photonmap::Photon;
 use crate::integrator::sppm::passes::PixelVisit;
 use crate::integrator::vcm;
-use crate::integrator::PhotonMapSettings;
+use crate::integrator::{IntegratorKind, PhotonMapSettings};
 use crate::math::{Bounds3, Vec2};
 use crate::scene::Scene;
 use candela_scene::Loc;
@@ -176,29 +176,48 @@ pub fn photons(n: i64, scale: &SceneScale) -> u64 {
     }
 }
 
-/// A warning for a written radius far from the scene's scale.
-/// `footprints` is the integrator's default in pixel footprints.
+/// What the default radius of `kind` is, in words and in scene units, for
+/// the warnings: SPPM's and PPM's [`FOOTPRINT_PIXELS`] footprints, or VCM's
+/// radius from the light vertices' density, within its pilot's bounds.
+pub fn default_radius_text(kind: IntegratorKind, scale: &SceneScale) -> String {
+    if kind == IntegratorKind::Vcm {
+        let (lo, hi) = (vcm::pilot::MIN_FOOTPRINTS, vcm::pilot::MAX_FOOTPRINTS);
+        let fp = VCM_FOOTPRINT_PIXELS;
+        format!(
+            "the default, chosen from the light vertices' density between {lo} and {hi} pixel footprints ({:.3e} to {:.3e} here)",
+            scale.default_radius_in(lo * fp),
+            scale.default_radius_in(hi * fp)
+        )
+    } else {
+        format!(
+            "the default of {FOOTPRINT_PIXELS} pixel footprints ({:.3e} here)",
+            scale.default_radius_in(FOOTPRINT_PIXELS)
+        )
+    }
+}
+
+/// A warning for a written radius far from the scene's scale; `default`
+/// says what leaving it out gives ([`default_radius_text`]).
 pub fn radius_warning(
     loc: &Loc,
     name: &str,
     radius: f32,
     scale: &SceneScale,
-    footprints: f32,
+    default: &str,
 ) -> Option<String> {
     let diagonal = scale.diagonal();
     if diagonal <= 0.0 {
         return None;
     }
     let share = radius / diagonal;
-    let suggested = scale.default_radius_in(footprints);
     if share > 0.05 {
         Some(format!(
-            "{loc}: {name} \"radius\" {radius} is {:.0}% of the scene's diagonal ({diagonal:.3}): expect blur and slow early passes; leave it out for the default of {footprints} pixel footprints ({suggested:.3e} here)",
+            "{loc}: {name} \"radius\" {radius} is {:.0}% of the scene's diagonal ({diagonal:.3}): expect blur (each photon's light spread over a disk of that radius) and slow early passes; leave it out for {default}",
             share * 100.0
         ))
     } else if share < 1e-5 {
         Some(format!(
-            "{loc}: {name} \"radius\" {radius} is tiny against the scene's diagonal ({diagonal:.3}): visible points will gather almost no photons; leave it out for the default of {footprints} pixel footprints ({suggested:.3e} here)"
+            "{loc}: {name} \"radius\" {radius} is tiny against the scene's diagonal ({diagonal:.3}): visible points will gather almost no photons; leave it out for {default}"
         ))
     } else {
         None
