@@ -234,7 +234,13 @@ pub fn render(
     let t0 = Instant::now();
     let shared = Shared {
         done: AtomicU64::new(at_start),
-        status: std::sync::Mutex::new(setup.integrator.status(&state.integrator_state, 0)),
+        // The first pass this process renders: not 0 after --resume or in a
+        // --pass-range (the progress line said "iteration 1" there).
+        status: std::sync::Mutex::new(
+            setup
+                .integrator
+                .status(&state.integrator_state, todo.first().copied().unwrap_or(0)),
+        ),
         finished: AtomicBool::new(false),
     };
     let snap = || Snapshot {
