@@ -359,6 +359,41 @@ fn light_tracing_alone_needs_a_camera_light_paths_can_reach() {
     );
 }
 
+/// A shutter that closes when it opens (or before) would give a black image
+/// (the exposure time scales the sensor's response): refused at the Camera
+/// directive, as pbrt-v4 does (it said nothing and rendered black before).
+#[test]
+fn the_shutter_must_open() {
+    let case = |times: &str, msg: &str| {
+        let o = opts("", "Camera", "");
+        Case {
+            text: o.text.replace(
+                "Camera \"perspective\"",
+                &format!("Camera \"perspective\" {times}"),
+            ),
+            at: "Camera",
+            msg: msg.into(),
+        }
+    };
+    check_all(
+        "shutter",
+        &[
+            case(
+                "\"float shutteropen\" [0.5] \"float shutterclose\" [0.5]",
+                "\"shutteropen\" and \"shutterclose\" are both 0.5: the shutter never opens, so the exposure time is 0 and the image would be black",
+            ),
+            case(
+                "\"float shutterclose\" [0]",
+                "\"shutteropen\" and \"shutterclose\" are both 0: the shutter never opens, so the exposure time is 0 and the image would be black",
+            ),
+            case(
+                "\"float shutteropen\" [1] \"float shutterclose\" [0.5]",
+                "\"shutterclose\" is before \"shutteropen\"",
+            ),
+        ],
+    );
+}
+
 #[test]
 fn memory_hungry_settings_are_refused_before_allocating_even_by_info() {
     let over = "over the memory limit";

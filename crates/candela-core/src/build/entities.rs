@@ -171,6 +171,14 @@ pub fn shutter(desc: &SceneDescription) -> Result<(f32, f32), BuildError> {
             "\"shutterclose\" is before \"shutteropen\"",
         ));
     }
+    // The exposure time scales the sensor's response (pbrt-v4 refuses it
+    // too, scene.cpp): a shutter that never opens gives a black image.
+    if close == open {
+        return Err(BuildError::at(
+            &c.loc,
+            format!("\"shutteropen\" and \"shutterclose\" are both {open}: the shutter never opens, so the exposure time is 0 and the image would be black"),
+        ));
+    }
     Ok((open, close))
 }
 
