@@ -35,7 +35,9 @@
 //! at vertices d ≤ `max_depth`. With `emission_beyond` the emission of
 //! vertex `max_depth` + 1 also counts, so a path of `max_depth` scattering
 //! events ends on a light as in the path tracer (the photon map); without
-//! it the walk ends at vertex `max_depth`, as pbrt-v4's SPPM does.
+//! it the walk ends at vertex `max_depth`, as pbrt-v4's SPPM does, but
+//! for the first hit, whose emission counts at `max_depth` 0 too (as
+//! there).
 
 use super::nee::{sample_light, Receiver};
 use super::subpath::{walk, Dispersion, Escape, Flow, Start, Vertex, Visitor, Walk};
@@ -277,7 +279,10 @@ where
     R: PathRng + ?Sized,
     F: FnMut(&Vertex, &SurfaceInteraction, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
 {
-    let walk_max_depth = cw.max_depth + u32::from(cw.emission_beyond);
+    // The first hit is always visited, for the emission it shows (or the
+    // infinite lights if the ray escapes): pbrt-v4's SPPM camera pass counts
+    // it at maxdepth 0 too, then stops.
+    let walk_max_depth = (cw.max_depth + u32::from(cw.emission_beyond)).max(1);
     let w = Walk {
         mode: TransportMode::Radiance,
         max_depth: walk_max_depth,

@@ -138,10 +138,11 @@ impl VcmIntegrator {
         // A path of maxdepth scattering vertices may end on a light one
         // vertex further; mode ppm limits each subpath instead, as `ppm`
         // does (module doc of [`super`], "Depth").
+        // In both, the first hit's emission counts even at maxdepth 0.
         let extra = u32::from(!self.techniques.ppm);
         let w = Walk {
             mode: TransportMode::Radiance,
-            max_depth: self.settings.max_depth + extra,
+            max_depth: (self.settings.max_depth + extra).max(1),
             roulette: Some(Roulette::Bidirectional),
             regularize: self.settings.regularize,
             dispersion: Dispersion::Fold,
