@@ -3,6 +3,9 @@
 use crate::interaction::{LightId, MaterialId};
 use crate::shape::Shape;
 
+/// Continued rays after cut-out hits of one primitive ([`Primitive::hit`]).
+const MAX_CUTOUT_CONTINUATIONS: usize = 3;
+
 /// One intersectable object.
 #[derive(Clone, Debug)]
 pub struct Primitive {
@@ -49,10 +52,48 @@ impl Primitive {
         t_max: f32,
     ) -> Option<crate::shape::DeferredHit> {
         let hit = self.shape.intersect_deferred(ray, wr, t_max)?;
-        if self.alpha.is_some() && !self.alpha_passes(self.shape.finish_hit(hit, ray).si, ray) {
+        if self.alpha.is_none() {
+            return Some(hit);
+        }
+        let first = self.shape.finish_hit(hit, ray);
+        if self.alpha_passes(first.si, ray) {
+            return Some(hit);
+        }
+        self.hit_beyond(first, ray, t_max)
+    }
+
+    /// The next hit of this shape along `ray` after the cut-out hit `cut`
+    /// that survives the alpha test, as pbrt-v4's `GeometricPrimitive`
+    /// finds it: a ray continued from the rejected point, its `t` added to
+    /// the first's. A sphere, cylinder or bilinear patch can be hit again
+    /// (the far side seen through a hole, which without this was skipped:
+    /// see-through spheres showed the floor where pbrt-v4 shows their
+    /// inside); a triangle or disk cannot. Each continued ray draws its own
+    /// alpha test ([`Self::alpha_passes`] hashes the ray), as in pbrt-v4.
+    fn hit_beyond(
+        &self,
+        cut: crate::shape::ShapeIntersection,
+        ray: &crate::math::Ray,
+        t_max: f32,
+    ) -> Option<crate::shape::DeferredHit> {
+        use crate::shape::Shape;
+        if matches!(self.shape, Shape::Triangle(_) | Shape::Disk(_)) {
             return None;
         }
-        Some(hit)
+        let (mut cut, mut t) = (cut, cut.t_hit);
+        // Two roots for the quadrics and the bilinear patch: one more hit
+        // at most, and a bound against round-off finding the same point.
+        for _ in 0..MAX_CUTOUT_CONTINUATIONS {
+            let next = cut.si.spawn_ray(ray.d);
+            let mut h = self.shape.intersect(&next, t_max - t)?;
+            t += h.t_hit;
+            h.t_hit = t;
+            if self.alpha_passes(h.si, &next) {
+                return Some(crate::shape::DeferredHit::Done(h));
+            }
+            cut = h;
+        }
+        None
     }
 
     /// True if the primitive blocks the ray before `t_max` (alpha-tested).

@@ -111,3 +111,54 @@ fn scene_intersection_matches_brute_force() {
     }
     assert!(hits > 300 && hits < 2900, "{hits} hits");
 }
+
+/// A sphere cut out with constant α = 0.4 blocks a ray through it with
+/// probability 1 − (1 − α)² = 0.64: after the near side is cut out, the far
+/// side gets its own alpha test (pbrt-v4's continued ray); skipping it gave
+/// α = 0.4. Over N = 20,000 rays through the sphere's middle the blocked
+/// share's standard deviation is √(0.64·0.36/N) = 0.0034: the bound is 5σ.
+/// Closest hits land on the near or the far side (t = 2 or 4 here), and
+/// intersect and intersect_p agree ray by ray.
+#[test]
+fn a_cut_out_sphere_is_seen_through_to_its_far_side() {
+    let at = Arc::new(Transform::IDENTITY);
+    let s = Sphere::new(at, false, 1.0, -1.0, 1.0, 360.0);
+    let scene = Scene::new(
+        vec![prim(Shape::Sphere(s), Some(0.4))],
+        vec![],
+        vec![],
+        crate::light::LightSelection::Uniform,
+    );
+    let mut r = Pcg32::new(5, 1);
+    let n = 20_000;
+    let (mut blocked, mut far) = (0usize, 0usize);
+    for k in 0..n {
+        // Along −z from z = 3, through the middle of the unit sphere.
+        let o = Vec3::new(0.1 * r.uniform_f32(), 0.1 * r.uniform_f32(), 3.0);
+        let ray = Ray::new(o, Vec3::new(0.0, 0.0, -1.0));
+        let hit = scene.intersect(&ray, f32::INFINITY);
+        assert_eq!(
+            hit.is_some(),
+            scene.intersect_p(&ray, f32::INFINITY),
+            "ray {k}"
+        );
+        if let Some(si) = hit {
+            let t = (si.p() - o).length();
+            let near = (t - 2.0).abs() < 0.01;
+            assert!(near || (t - 4.0).abs() < 0.01, "ray {k}: t = {t}");
+            blocked += 1;
+            far += usize::from(!near);
+        }
+    }
+    let share = blocked as f64 / n as f64;
+    let sigma = (0.64f64 * 0.36 / n as f64).sqrt();
+    assert!(
+        (share - 0.64).abs() < 5.0 * sigma,
+        "blocked {share}, want 0.64 ± {sigma}"
+    );
+    // Of those, the far side: (1 − α)·α / 0.64 = 0.375.
+    assert!(
+        far as f64 > 0.3 * blocked as f64,
+        "{far} far hits of {blocked}"
+    );
+}
