@@ -12,7 +12,9 @@
 //! render as before). Then the value is scaled, optionally inverted
 //! (1 − v), and clamped at 0.
 //!
-//! A float texture reads the first channel. A spectrum texture lifts the
+//! A float texture reads an RGB image as pbrt-v4 does: the first channel of
+//! a texel, but the mean of the three where the filter interpolates
+//! (bilinear, the default, and trilinear). A spectrum texture lifts the
 //! RGB (a grey image's value repeated) in the image's colour space with the
 //! meaning its use requires (albedo: clamped to [0, 1]; unbounded;
 //! illuminant), through the colour space's precomputed table
@@ -84,9 +86,42 @@ impl ImageTexture {
         }
     }
 
-    /// Float value at a hit: first channel, scaled, inverted as 1 − v clamped at 0.
+    /// The float pbrt-v4's `MIPMap::Filter<Float>` returns: a texel's first
+    /// channel (`Texel<Float>`: point, EWA, a footprint covering the whole
+    /// texture), but the mean of an RGB image's three channels where it
+    /// interpolates (`Bilerp<Float>`: bilinear, trilinear, EWA with a
+    /// degenerate ellipse). A grey image gives its one channel either way.
+    fn lookup_float(&self, (st, d0, d1): (Vec2, Vec2, Vec2)) -> f32 {
+        let p = &self.pyramid;
+        let rgb = p.base().channels == 3;
+        let mean = |c: [f32; 3]| {
+            if rgb {
+                (c[0] + c[1] + c[2]) / 3.0
+            } else {
+                c[0]
+            }
+        };
+        match self.filter {
+            ImageFilter::Point => p.single_level(st, d0, d1, self.wrap, true)[0],
+            ImageFilter::Bilinear | ImageFilter::Trilinear => {
+                if p.finite_level(p.footprint_level(d0, d1)).is_none() {
+                    return p.top_texel(self.wrap)[0];
+                }
+                mean(self.lookup_rgb((st, d0, d1)))
+            }
+            ImageFilter::Ewa { .. } => {
+                if d0.length_squared().min(d1.length_squared()) == 0.0 {
+                    return mean(p.base().bilerp_rgb(st, self.wrap));
+                }
+                self.lookup_rgb((st, d0, d1))[0]
+            }
+        }
+    }
+
+    /// Float value at a hit ([`Self::lookup_float`]), scaled, inverted as
+    /// 1 − v clamped at 0.
     pub fn evaluate_float(&self, ctx: &TextureEvalContext) -> f32 {
-        let raw = self.lookup_rgb(self.st(ctx))[0];
+        let raw = self.lookup_float(self.st(ctx));
         let v = self.scale * raw;
         if self.invert {
             (1.0 - v).max(0.0)
@@ -177,5 +212,47 @@ mod tests {
         assert_eq!(inv.evaluate_float(&at(0.9, 0.9)), 0.5);
         let rgb = inv.evaluate_rgb(&at(0.9, 0.9));
         assert_eq!((rgb.r, rgb.g, rgb.b), (0.5, 0.5, 0.5));
+    }
+
+    /// A float texture of an RGB image, as pbrt-v4's `MIPMap` reads it:
+    /// point sampling (and EWA) take a texel's first channel, bilinear and
+    /// trilinear (`Bilerp<Float>`) the mean of its three. One texel of
+    /// (0.9, 0.3, 0.0): 0.9 by point, 0.4 by bilinear — candela read 0.9 for
+    /// both, which a pbrt-v4 parity check saw (a float imagemap from an RGB
+    /// file driving a mix: 0.99/1.00/1.02 of pbrt-v4's image, 1.09 and 0.84
+    /// on the floor; now within the noise).
+    #[test]
+    fn a_float_texture_reads_an_rgb_image_as_pbrt_v4() {
+        let rgb_tex = |filter| ImageTexture {
+            pyramid: Arc::new(MipPyramid::build(MapImage::new(
+                1,
+                1,
+                3,
+                vec![0.9, 0.3, 0.0],
+                PixelFormat::Float,
+            ))),
+            ..tex(filter, WrapMode::Clamp)
+        };
+        let mean = (0.9f32 + 0.3 + 0.0) / 3.0;
+        assert_eq!(
+            rgb_tex(ImageFilter::Point).evaluate_float(&at(0.5, 0.5)),
+            0.9
+        );
+        for f in [ImageFilter::Bilinear, ImageFilter::Trilinear] {
+            assert_eq!(rgb_tex(f).evaluate_float(&at(0.5, 0.5)), mean, "{f:?}");
+        }
+        // EWA with a real footprint sums texels: the first channel.
+        let ewa = rgb_tex(ImageFilter::Ewa {
+            max_anisotropy: 8.0,
+        });
+        let ctx = TextureEvalContext {
+            dudx: 0.1,
+            dvdy: 0.1,
+            ..at(0.5, 0.5)
+        };
+        assert!((ewa.evaluate_float(&ctx) - 0.9).abs() < 1e-6);
+        // A grey image is its one channel whatever the filter.
+        let grey = tex(ImageFilter::Bilinear, WrapMode::Clamp);
+        assert!((grey.evaluate_float(&at(0.5, 0.5)) - 1.5).abs() < 1e-6);
     }
 }
