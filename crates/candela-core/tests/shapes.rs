@@ -375,3 +375,43 @@ fn plymesh_file_errors_name_the_parameter_or_the_place_in_the_file() {
     );
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// A floor triangle reaching `reach` from the origin under a 2-unit room
+/// seen from inside: build warnings.
+fn reach_warnings(reach: f32) -> Vec<String> {
+    let text = format!(
+        r#"LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" [40]
+Film "rgb" "integer xresolution" [64] "integer yresolution" [48]
+WorldBegin
+LightSource "point" "point3 from" [0 0.8 0] "rgb I" [1 1 1]
+Material "diffuse"
+Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1] "integer indices" [0 1 2 0 2 3]
+Shape "trianglemesh" "point3 P" [-{reach} -0.9 -{reach}  {reach} -0.9 -{reach}  0 -0.9 {reach}] "integer indices" [0 1 2]
+"#
+    );
+    let desc = candela_scene::parse_str(&text, Path::new("t.pbrt")).expect("parses");
+    build(&desc, &Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .warnings
+}
+
+/// Single precision spaces positions |x|·2⁻²³ apart: a triangle reaching
+/// 10¹⁰ (spacing ≈ 1,200) under a room whose pixels are ≈ 0.05 wide is
+/// rounded by far more than a pixel, and the scene says so (it rendered
+/// silently wrong: invisible to camera rays, yet shadowing the room); at
+/// 10⁴ (spacing ≈ 0.0012) it is fine and says nothing.
+#[test]
+fn geometry_too_far_for_single_precision_is_warned_about() {
+    let far = reach_warnings(1e10);
+    assert!(
+        far.iter()
+            .any(|w| w.contains("single-precision positions are")),
+        "{far:?}"
+    );
+    let near = reach_warnings(1e4);
+    assert!(
+        !near.iter().any(|w| w.contains("single-precision")),
+        "{near:?}"
+    );
+}

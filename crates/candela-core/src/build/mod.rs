@@ -171,9 +171,12 @@ pub fn build(desc: &SceneDescription, ov: &Overrides) -> Result<RenderSetup, Bui
             sampler.samples_per_pixel(),
         )));
     }
+    // 256 camera rays: the pixel footprint at the visible surfaces, for the
+    // photon radii and the precision warning.
+    let scale = photon_scale::SceneScale::measure(&scene, &camera, &film);
+    warnings.extend(photon_scale::precision_warning(&scale));
     let integrator = match kind {
         k if integrators::needs_scale(k) => {
-            let scale = photon_scale::SceneScale::measure(&scene, &camera, &film);
             integrators::finish(plan, &scale, &mut budget, &mut warnings)?
         }
         _ => integrators::finish(

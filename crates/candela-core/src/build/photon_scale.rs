@@ -176,6 +176,25 @@ pub fn photons(n: i64, scale: &SceneScale) -> u64 {
     }
 }
 
+/// A warning when single precision cannot place the scene's geometry to
+/// within a pixel: positions are f32, spaced |x|·2⁻²³ apart at coordinate
+/// x, so where the scene reaches further from the origin than the pixel
+/// footprint at the visible surfaces allows, its surfaces there are
+/// rounded by more than a pixel and rays can miss or find them wrongly (a
+/// triangle of 10¹⁰ units drawn across a 2-unit room vanished from camera
+/// rays yet shadowed the room). pbrt-v4 has the same limit and no warning.
+pub fn precision_warning(scale: &SceneScale) -> Option<String> {
+    let width = scale.footprint?;
+    let b = scale.bounds;
+    let reach = b.min.abs().max(b.max.abs()).max_element();
+    let spacing = reach * f32::EPSILON;
+    (reach.is_finite() && spacing > width).then(|| {
+        format!(
+            "the scene reaches {reach:.3e} from the origin, where single-precision positions are {spacing:.2e} apart, more than a pixel's width at the visible surfaces ({width:.2e}): geometry there can be misplaced or missed (keep the scene near the origin, or its far parts smaller)"
+        )
+    })
+}
+
 /// What the default radius of `kind` is, in words and in scene units, for
 /// the warnings: SPPM's and PPM's [`FOOTPRINT_PIXELS`] footprints, or VCM's
 /// radius from the light vertices' density, within its pilot's bounds.
