@@ -98,27 +98,31 @@ fn t4b_sppm_and_ppm_have_no_kernel_bias_in_the_sphere_furnace() {
     const K: u64 = 6;
     for integrator in ["sppm", "ppm"] {
         let scene = furnace(integrator, 1.0);
-        let means: Vec<[f64; 3]> = (0..K)
-            .map(|seed| {
-                let ov = Overrides {
-                    spp: Some(64),
-                    seed: Some(seed + 1),
-                    ..Default::default()
-                };
-                render_str(&scene, &ov).channel_means()
-            })
-            .collect();
-        for c in 0..3 {
-            let m = means.iter().map(|v| v[c]).sum::<f64>() / K as f64;
-            let var = means.iter().map(|v| (v[c] - m).powi(2)).sum::<f64>() / (K - 1) as f64;
-            let se = (var / K as f64).sqrt();
-            eprintln!("{integrator} furnace channel {c}: {m:.5} ± {se:.5} (expected 1)");
-            // 2e-3: the RGB ↔ spectrum round trip (as in closed_forms.rs).
-            assert!(
-                (m - 1.0).abs() <= 5.0 * se + 2e-3,
-                "{integrator}: {m} ± {se}"
-            );
-        }
+        assert_image_means_are_one(&scene, K, &format!("{integrator} furnace"));
+    }
+}
+
+/// Asserts that every channel's image mean of `scene` (64 spp) is 1 within
+/// 5σ + 2e-3 over `k` seeds: σ from the seeds' spread (an image's pixels
+/// may share photons or wavelengths, so they are not independent), 2e-3
+/// the RGB ↔ spectrum round trip (as in closed_forms.rs).
+fn assert_image_means_are_one(scene: &str, k: u64, what: &str) {
+    let means: Vec<[f64; 3]> = (0..k)
+        .map(|seed| {
+            let ov = Overrides {
+                spp: Some(64),
+                seed: Some(seed + 1),
+                ..Default::default()
+            };
+            render_str(scene, &ov).channel_means()
+        })
+        .collect();
+    for c in 0..3 {
+        let m = means.iter().map(|v| v[c]).sum::<f64>() / k as f64;
+        let var = means.iter().map(|v| (v[c] - m).powi(2)).sum::<f64>() / (k - 1) as f64;
+        let se = (var / k as f64).sqrt();
+        eprintln!("{what}, channel {c}: {m:.5} ± {se:.5} (expected 1)");
+        assert!((m - 1.0).abs() <= 5.0 * se + 2e-3, "{what}: {m} ± {se}");
     }
 }
 
@@ -216,25 +220,6 @@ ReverseOrientation
 Shape "sphere" "float radius" [1]
 "#
         );
-        let means: Vec<[f64; 3]> = (0..K)
-            .map(|seed| {
-                let ov = Overrides {
-                    spp: Some(64),
-                    seed: Some(seed + 1),
-                    ..Default::default()
-                };
-                render_str(&scene, &ov).channel_means()
-            })
-            .collect();
-        for c in 0..3 {
-            let m = means.iter().map(|v| v[c]).sum::<f64>() / K as f64;
-            let var = means.iter().map(|v| (v[c] - m).powi(2)).sum::<f64>() / (K - 1) as f64;
-            let se = (var / K as f64).sqrt();
-            eprintln!("{integrator} maxdepth 0, channel {c}: {m:.5} ± {se:.5} (expected 1)");
-            assert!(
-                (m - 1.0).abs() <= 5.0 * se + 2e-3,
-                "{integrator}: {m} ± {se}"
-            );
-        }
+        assert_image_means_are_one(&scene, K, &format!("{integrator} maxdepth 0"));
     }
 }
