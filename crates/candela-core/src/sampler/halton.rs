@@ -28,40 +28,15 @@
 //!
 //! After the first 1000 primes the dimension wraps to 2, as in pbrt-v4.
 
+use super::radical::{bases, for_each_digit, radical_inverse, to_unit, ScrambledHalton};
 use crate::math::{UVec2, Vec2};
-use crate::sampling::{hash_u64s, mix_bits, Pcg32, ONE_MINUS_EPSILON};
-use std::sync::{Arc, OnceLock};
+use crate::sampling::{hash_u64s, mix_bits};
+use std::sync::Arc;
 
-/// Dimensions (primes) before the sequence wraps to dimension 2.
-pub const PRIME_TABLE_SIZE: usize = 1000;
+pub use super::radical::PRIME_TABLE_SIZE;
 
 /// Film resolution beyond which the pixel pattern repeats [pbrt-v4].
 const MAX_RESOLUTION: u32 = 128;
-
-/// The first [`PRIME_TABLE_SIZE`] primes (the 1000th is 7919).
-static PRIMES: [u32; PRIME_TABLE_SIZE] = primes();
-
-const fn primes() -> [u32; PRIME_TABLE_SIZE] {
-    let mut out = [0u32; PRIME_TABLE_SIZE];
-    let (mut n, mut found) = (2u32, 0usize);
-    while found < PRIME_TABLE_SIZE {
-        let mut d = 2;
-        let mut prime = true;
-        while d * d <= n {
-            if n % d == 0 {
-                prime = false;
-                break;
-            }
-            d += 1;
-        }
-        if prime {
-            out[found] = n;
-            found += 1;
-        }
-        n += 1;
-    }
-    out
-}
 
 /// How the Halton points are randomised (module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -87,72 +62,6 @@ impl HaltonRandomize {
             _ => None,
         }
     }
-}
-
-/// Digit positions a 32-bit float resolves in base `b` (pbrt-v4's count:
-/// until (b − 1)·b^−n no longer changes 1 − ·).
-fn digits(b: u32) -> u32 {
-    let inv = 1.0 / b as f32;
-    let (mut n, mut inv_m) = (0, 1.0f32);
-    while 1.0 - (b - 1) as f32 * inv_m < 1.0 {
-        n += 1;
-        inv_m *= inv;
-    }
-    n
-}
-
-/// A prime base, its digit count ([`digits`]) and b^n (exact in f64).
-#[derive(Debug)]
-struct Base {
-    b: u64,
-    n: u32,
-    scale: f64,
-}
-
-/// The bases of all dimensions, computed once.
-fn bases() -> &'static [Base] {
-    static BASES: OnceLock<Vec<Base>> = OnceLock::new();
-    BASES.get_or_init(|| {
-        PRIMES
-            .iter()
-            .map(|&b| {
-                let n = digits(b);
-                Base {
-                    b: u64::from(b),
-                    n,
-                    scale: (b as f64).powi(n as i32),
-                }
-            })
-            .collect()
-    })
-}
-
-/// `v / scale` as a sample in [0, 1).
-fn to_unit(v: u64, scale: f64) -> f32 {
-    ((v as f64 / scale) as f32).min(ONE_MINUS_EPSILON)
-}
-
-/// The next base-`b` digit of `a` (least significant first); `a` loses it.
-#[inline]
-fn next_digit(a: &mut u64, b: u64) -> u64 {
-    if *a == 0 {
-        return 0; // Trailing zeros: no division.
-    }
-    let q = *a / b;
-    let v = *a - q * b;
-    *a = q;
-    v
-}
-
-/// The radical inverse of `a` in base `b`, unrandomised.
-fn radical_inverse(b: u32, mut a: u64) -> f32 {
-    let b = u64::from(b);
-    let (mut reversed, mut scale) = (0u64, 1.0f64);
-    while a != 0 {
-        reversed = reversed * b + next_digit(&mut a, b);
-        scale *= b as f64;
-    }
-    to_unit(reversed, scale)
 }
 
 /// The index whose first `n` base-`b` digits, reversed, are `inverse`'s.
@@ -221,46 +130,6 @@ fn kensler_permute(mut i: u32, l: u32, p: u32) -> u32 {
     ((u64::from(i) + u64::from(p)) % u64::from(l)) as u32
 }
 
-/// A uniformly random permutation of `0..n` (Fisher–Yates from a PCG32
-/// stream seeded by `h`).
-fn shuffled(n: u32, h: u64) -> Vec<u16> {
-    let mut rng = Pcg32::new(h, mix_bits(h));
-    let mut p: Vec<u16> = (0..n as u16).collect();
-    for i in (1..n as usize).rev() {
-        let j = (rng.uniform_f64() * (i + 1) as f64) as usize;
-        p.swap(i, j.min(i));
-    }
-    p
-}
-
-/// The digit permutations of every dimension, made on first use and shared
-/// by the clones of a sampler.
-#[derive(Debug)]
-struct Permutations {
-    seed: u64,
-    tables: Vec<OnceLock<Box<[u16]>>>,
-}
-
-impl Permutations {
-    fn new(seed: u64) -> Self {
-        Self {
-            seed,
-            tables: (0..PRIME_TABLE_SIZE).map(|_| OnceLock::new()).collect(),
-        }
-    }
-
-    /// Dimension `d`'s table: digit position k's permutation of digit v at
-    /// `k·b + v`, for the n digit positions of [`bases`].
-    fn of(&self, d: usize) -> &[u16] {
-        self.tables[d].get_or_init(|| {
-            let Base { b, n, .. } = bases()[d];
-            (0..n)
-                .flat_map(|k| shuffled(b as u32, hash_u64s(&[b, u64::from(k), self.seed])))
-                .collect()
-        })
-    }
-}
-
 /// The Halton sampler; see the module docs.
 #[derive(Clone, Debug)]
 pub struct HaltonSampler {
@@ -274,7 +143,7 @@ pub struct HaltonSampler {
     exponents: [u32; 2],
     /// (3^k)⁻¹ mod 2^j and (2^j)⁻¹ mod 3^k.
     inverses: [u64; 2],
-    permutations: Arc<Permutations>,
+    permutations: Arc<ScrambledHalton>,
     index: u64,
     dimension: u32,
 }
@@ -303,7 +172,7 @@ impl HaltonSampler {
             scales,
             exponents,
             inverses,
-            permutations: Arc::new(Permutations::new(seed)),
+            permutations: Arc::new(ScrambledHalton::new(seed)),
             index: 0,
             dimension: 2,
         }
@@ -365,32 +234,28 @@ impl HaltonSampler {
     }
 
     fn sample_dimension(&self, d: usize) -> f32 {
-        let Base { b, n, scale } = bases()[d];
-        let (mut a, mut reversed) = (self.index, 0u64);
-        match self.randomize {
-            HaltonRandomize::None => return radical_inverse(b as u32, a),
-            HaltonRandomize::PermuteDigits => {
-                let perm = self.permutations.of(d);
-                for row in perm.chunks_exact(b as usize) {
-                    let v = next_digit(&mut a, b);
-                    reversed = reversed * b + u64::from(row[v as usize]);
-                }
-            }
+        let base = &bases()[d];
+        let reversed = match self.randomize {
+            HaltonRandomize::None => return radical_inverse(base.b as u32, self.index),
+            HaltonRandomize::PermuteDigits => self.permutations.table(d).reversed(base, self.index),
             HaltonRandomize::Owen => {
                 let hash = hash_u64s(&[d as u64, self.seed, 0x6f77_656e]);
-                for _ in 0..n {
-                    let v = next_digit(&mut a, b) as u32;
-                    let v = kensler_permute(v, b as u32, mix_bits(hash ^ reversed) as u32);
-                    reversed = reversed * b + u64::from(v);
-                }
+                let mut reversed = 0u64;
+                for_each_digit(base, self.index, |v| {
+                    let p = mix_bits(hash ^ reversed) as u32;
+                    let v = kensler_permute(v as u32, base.b as u32, p);
+                    reversed = reversed * base.b + u64::from(v);
+                });
+                reversed
             }
-        }
-        to_unit(reversed, scale)
+        };
+        to_unit(reversed, base.scale)
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::radical::{digits, PRIMES};
     use super::*;
 
     #[test]

@@ -22,6 +22,7 @@
 
 mod halton;
 mod independent;
+mod radical;
 mod sobol;
 
 pub use halton::{HaltonRandomize, HaltonSampler};
