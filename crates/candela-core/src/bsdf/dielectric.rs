@@ -163,11 +163,17 @@ impl DielectricBxdf {
         let Some(h) = self.half_vector(wo, wi) else {
             return SampledSpectrum::zero();
         };
-        let (cos_o, cos_i) = (local::cos_theta(wo), local::cos_theta(wi));
         let dg = self.distrib.d(h.wm) * self.distrib.g(wo, wi);
+        SampledSpectrum::splat(self.f_at(&h, wo, wi, dg, mode))
+    }
+
+    /// f at the half vector `h` of (wo, wi), given D(ωm)·G(ωo, ωi).
+    #[inline]
+    fn f_at(&self, h: &HalfVector, wo: Vec3, wi: Vec3, dg: f32, mode: TransportMode) -> f32 {
+        let (cos_o, cos_i) = (local::cos_theta(wo), local::cos_theta(wi));
         if h.reflect {
             let fr = fr_dielectric(h.dot_o, self.eta);
-            return SampledSpectrum::splat(dg * fr / (4.0 * cos_i * cos_o).abs());
+            return dg * fr / (4.0 * cos_i * cos_o).abs();
         }
         // [Walter et al. 2007, eq. 21]; Fresnel from both facet cosines keeps
         // f reciprocal to round-off near the critical angle.
@@ -176,7 +182,7 @@ impl DielectricBxdf {
         if mode == TransportMode::Radiance {
             ft /= sqr(h.etap);
         }
-        SampledSpectrum::splat(ft)
+        ft
     }
 
     /// Density of [`Self::sample_f`]; zero for the delta cases.
@@ -193,24 +199,29 @@ impl DielectricBxdf {
         let Some(h) = self.half_vector(wo, wi) else {
             return PdfSolidAngle(0.0);
         };
+        let d = self.distrib.d(h.wm);
+        PdfSolidAngle(self.pdf_at(&h, wo, d, self.distrib.g1(wo), allowed))
+    }
+
+    /// The density at the half vector `h` of (wo, wi), given D(ωm) and G1(ωo).
+    #[inline]
+    fn pdf_at(&self, h: &HalfVector, wo: Vec3, d: f32, g1: f32, allowed: SampleFlags) -> f32 {
         let (pr, pt) = lobe_probs(
             fr_dielectric(h.dot_o, self.eta),
             ft_dielectric(h.dot_o, self.eta),
             allowed,
         );
         if pr == 0.0 && pt == 0.0 {
-            return PdfSolidAngle(0.0);
+            return 0.0;
         }
         // Visible-normal density D_ωo(ωm) [Heitz 2018, eq. 1].
-        let d_vis =
-            self.distrib.g1(wo) / local::abs_cos_theta(wo) * self.distrib.d(h.wm) * h.dot_o.abs();
-        let pdf = if h.reflect {
+        let d_vis = g1 / local::abs_cos_theta(wo) * d * h.dot_o.abs();
+        if h.reflect {
             d_vis / (4.0 * h.dot_o.abs()) * pr / (pr + pt)
         } else {
             // [Walter et al. 2007, eq. 17]
             d_vis * h.dot_i.abs() / h.denom * pt / (pr + pt)
-        };
-        PdfSolidAngle(pdf)
+        }
     }
 
     /// Samples reflection or refraction.
@@ -308,12 +319,18 @@ impl DielectricBxdf {
             }
             (wi, BxdfFlags::GLOSSY_TRANSMISSION, etap)
         };
-        let pdf = self.pdf(wo, wi, mode, allowed).0;
+        // f and pdf as Self::f and Self::pdf give them, sharing the half
+        // vector, D(ωm) and Λ(ωo) (the same operations, the same bits).
+        let h = self.half_vector(wo, wi)?;
+        let d = self.distrib.d(h.wm);
+        let (lambda_o, lambda_i) = (self.distrib.lambda(wo), self.distrib.lambda(wi));
+        let pdf = self.pdf_at(&h, wo, d, 1.0 / (1.0 + lambda_o), allowed);
         if pdf == 0.0 {
             return None;
         }
+        let dg = d * (1.0 / (1.0 + lambda_o + lambda_i));
         Some(BsdfSample {
-            f: self.f(wo, wi, mode),
+            f: SampledSpectrum::splat(self.f_at(&h, wo, wi, dg, mode)),
             wi,
             pdf: PdfSolidAngle(pdf),
             flags,
