@@ -27,6 +27,8 @@ pub struct PerspectiveCamera {
     focal_distance: f32,
     /// Image area on the plane z = 1 in camera space.
     area: f32,
+    /// The lens point of a pinhole (the camera's position), made once.
+    pinhole: Interaction,
 }
 
 impl PerspectiveCamera {
@@ -38,8 +40,10 @@ impl PerspectiveCamera {
         check_lens(p)?;
         let screen = ScreenMap::new(p)?;
         let tan_half_fov = (0.5 * p.fov_deg.to_radians()).tan();
+        let frame = CameraFrame::new(p.camera_from_world);
         Ok(Self {
-            frame: CameraFrame::new(p.camera_from_world),
+            pinhole: frame.lens_interaction(Vec3::ZERO),
+            frame,
             screen,
             tan_half_fov,
             lens_radius: p.lens_radius,
@@ -125,10 +129,13 @@ impl PerspectiveCamera {
     /// Samples the lens uniformly and converts its area density to solid
     /// angle at the reference point [pbrt-v4 §5.4.2].
     pub fn sample_wi(&self, ref_p: &Interaction, u: Vec2) -> Option<CameraWiSample> {
-        let p_lens = self.lens_radius * sample_uniform_disk_concentric(u);
-        let lens = self
-            .frame
-            .lens_interaction(Vec3::new(p_lens.x, p_lens.y, 0.0));
+        let lens = if self.lens_radius > 0.0 {
+            let p_lens = self.lens_radius * sample_uniform_disk_concentric(u);
+            self.frame
+                .lens_interaction(Vec3::new(p_lens.x, p_lens.y, 0.0))
+        } else {
+            self.pinhole
+        };
         let to_lens = lens.p - ref_p.p;
         let dist2 = to_lens.length_squared();
         if dist2 == 0.0 {
