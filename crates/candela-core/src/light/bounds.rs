@@ -138,7 +138,8 @@ pub(crate) fn importance(b: &LightBounds, p: Vec3, n: Vec3) -> f32 {
 pub(crate) struct PreparedBounds {
     /// Box centre.
     pc: Vec3,
-    /// Radius² of the bounding sphere, which is centred on `pc`.
+    /// Radius of the bounding sphere, which is centred on `pc`, and its square.
+    r: f32,
     r2: f32,
     /// |diagonal| / 2 (pbrt-v4's lower bound of d²).
     half_diagonal: f32,
@@ -156,6 +157,7 @@ impl PreparedBounds {
         let (_, r) = b.bounds.bounding_sphere();
         Self {
             pc: b.bounds.centroid(),
+            r,
             r2: r * r,
             half_diagonal: b.bounds.diagonal().length() / 2.0,
             w: b.w,
@@ -181,12 +183,14 @@ impl PreparedBounds {
         let v = p - self.pc;
         let dist2 = v.length_squared();
         let d2 = dist2.max(self.half_diagonal);
-        let wi = v.normalize_or_zero();
+        // One square root and one division give the direction and sin θb.
+        let inv_dist = if dist2 > 0.0 { 1.0 / dist2.sqrt() } else { 0.0 };
+        let wi = v * inv_dist;
         let (sin_b, cos_b) = if dist2 <= self.r2 {
             (0.0, -1.0)
         } else {
-            let sin2 = self.r2 / dist2;
-            (sin2.sqrt(), safe_sqrt(1.0 - sin2))
+            let sin_b = self.r * inv_dist;
+            (sin_b, safe_sqrt(1.0 - sin_b * sin_b))
         };
         let mut cos_w = self.w.dot(wi);
         if self.two_sided {
