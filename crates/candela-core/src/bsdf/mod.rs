@@ -201,6 +201,15 @@ macro_rules! dispatch_bxdf {
 }
 
 impl Bxdf {
+    /// True when f and the sampling densities are the same at every
+    /// wavelength: the dielectric interfaces, whose Fresnel terms take one
+    /// scalar η (a spectrally varying η terminates the secondary
+    /// wavelengths instead). A path scattered only by these keeps a β that
+    /// holds at any wavelengths.
+    pub fn is_wavelength_independent(&self) -> bool {
+        matches!(self, Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_))
+    }
+
     /// f(wo, wi) in the local frame.
     #[inline]
     pub fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> SampledSpectrum {

@@ -230,6 +230,10 @@ fn visit_pixel(
     };
     let beta = SampledSpectrum::splat(cs.ray_weight);
     let mut vp = None;
+    // Every scattering before the visible point was by a BSDF that is the
+    // same at all wavelengths, so β is too and the point can weigh every
+    // group's photons with it.
+    let mut flat = true;
     visit.ld = camera_walk(
         ctx.scene,
         cs.ray,
@@ -241,11 +245,12 @@ fn visit_pixel(
             let flags = bsdf.flags();
             let glossy_last = flags.contains(BxdfFlags::GLOSSY) && v.depth == max_depth;
             if !flags.contains(BxdfFlags::DIFFUSE) && !glossy_last {
+                flat &= bsdf.bxdf.is_wavelength_independent();
                 return Flow::Continue;
             }
             let terminated = lam.secondary_terminated();
             let all_groups = !slots.is_empty()
-                && v.depth == 1
+                && flat
                 && !terminated
                 && other_group_bsdfs(ctx.scene, si, pw, group, slots);
             vp = Some(VisiblePoint {
