@@ -21,17 +21,20 @@
 //!
 //! Wavelengths come in stratified groups ([`crate::integrator::wavelengths`]):
 //! a pixel's camera path carries its group's wavelengths and photon `i`
-//! those of group `i mod G`. A visible point seen directly (the first hit of
-//! the camera ray, whose throughput does not depend on wavelength) gathers
-//! the photons of *every* group: at the camera pass its BSDF is also built
+//! those of group `i mod G`. A visible point whose camera-path throughput
+//! does not depend on wavelength (the first hit of the camera ray, or a
+//! point seen only through dielectrics, whose Fresnel terms take one scalar
+//! η: [`crate::bsdf::Bxdf::is_wavelength_independent`]) gathers the
+//! photons of *every* group: at the camera pass its BSDF is also built
 //! at the other groups' wavelengths, a photon of group h is weighed with
 //! the BSDF of group h, and each group's sum is converted to RGB with its
 //! own wavelengths. That is the average of G unbiased estimates, one per
 //! group (each photon's power scaled by N/(G·N_h)), so the point rests on
 //! all N photons of the pass while its colour noise stays its own instead
-//! of tinting the whole pass. A visible point reached through scattering
-//! (a mirror, glass) gathers only its own group's photons, with power
-//! scaled by N/N_g, as its throughput is known at its own wavelengths only.
+//! of tinting the whole pass. A visible point reached through any other
+//! scattering (a coloured mirror, a glossy metal, dispersive glass) gathers
+//! only its own group's photons, with power scaled by N/N_g, as its
+//! throughput is known at its own wavelengths only.
 //! The photon sums stay spectral, per group, until the pixel update
 //! converts them.
 //! Photon chunks return their contributions as lists merged in chunk order:
@@ -208,8 +211,9 @@ pub fn camera_pass(
 
 /// The camera walk of one pixel of group `group`: direct light on the way
 /// and the visible point at the first diffuse vertex (or a glossy one at
-/// `max_depth`); a visible point at the first hit also gets its BSDFs at
-/// the other groups' wavelengths in `slots` (G of them, or none when G = 1).
+/// `max_depth`); a visible point whose throughput holds at every
+/// wavelength (module doc) also gets its BSDFs at the other groups'
+/// wavelengths in `slots` (G of them, or none when G = 1).
 fn visit_pixel(
     ctx: &RenderContext<'_>,
     pixel: UVec2,
