@@ -130,8 +130,8 @@ pub(super) fn radical_inverse(b: u32, mut a: u64) -> f32 {
 }
 
 /// The digits of `a` in `base`, least significant first, each handed to
-/// `f` with its position, over all `base.n` positions (zeros above a's
-/// highest digit), by [`Base::split`].
+/// `f`, over all `base.n` positions (zeros above a's highest digit), by
+/// [`Base::split`].
 pub(super) fn for_each_digit(base: &Base, mut a: u64, mut f: impl FnMut(u64)) {
     for _ in 0..base.n {
         let (q, v) = base.split(a);
