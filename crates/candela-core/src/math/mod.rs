@@ -53,22 +53,12 @@ pub fn next_float_up(v: f32) -> f32 {
     }
 }
 
-/// Largest float strictly less than `v`.
+/// Largest float strictly less than `v`: the mirror image of
+/// [`next_float_up`] (negation only flips the sign bit, so it stays
+/// branch-free and keeps −∞, NaN and the zeros as they were).
 #[inline]
 pub fn next_float_down(v: f32) -> f32 {
-    // Selects, not branches (see `ray::round_away`); +0 counts as −0.
-    let z = if v == 0.0 { -0.0 } else { v };
-    let bits = z.to_bits();
-    let next = f32::from_bits(if z > 0.0 {
-        bits.wrapping_sub(1)
-    } else {
-        bits.wrapping_add(1)
-    });
-    if v == f32::NEG_INFINITY {
-        v
-    } else {
-        next
-    }
+    -next_float_up(-v)
 }
 
 /// `x²`.

@@ -76,7 +76,6 @@ impl Primitive {
         ray: &crate::math::Ray,
         t_max: f32,
     ) -> Option<crate::shape::DeferredHit> {
-        use crate::shape::Shape;
         if matches!(self.shape, Shape::Triangle(_) | Shape::Disk(_)) {
             return None;
         }
