@@ -301,7 +301,10 @@ impl DiffuseAreaLight {
 
     /// Density of [`sample_li`](Self::sample_li) for direction `wi`.
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> PdfSolidAngle {
-        self.shape.pdf_from(&self.shape_ctx(ctx), wi)
+        match &self.triangle {
+            Some(t) => t.pdf_from(&self.shape_ctx(ctx), wi),
+            None => self.shape.pdf_from(&self.shape_ctx(ctx), wi),
+        }
     }
 
     /// Point by area (`u1`), cosine-weighted direction (`u2`; `u2.x` also
@@ -359,7 +362,11 @@ impl DiffuseAreaLight {
         } else {
             0.0
         };
-        (self.shape.pdf_area(intr), PdfSolidAngle(pdf_dir))
+        let pdf_pos = match &self.triangle {
+            Some(t) => t.pdf_area(),
+            None => self.shape.pdf_area(intr),
+        };
+        (pdf_pos, PdfSolidAngle(pdf_dir))
     }
 
     /// Φ = πAL, doubled when two-sided (seed eq. 二.7); for an image, L is

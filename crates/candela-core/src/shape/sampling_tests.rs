@@ -295,6 +295,33 @@ fn sample_from_density_agrees_with_pdf_from() {
     }
 }
 
+#[test]
+fn triangle_sampler_density_is_the_shapes() {
+    // The light's shortcut (no surface interaction) against the shape's
+    // own `pdf_from`, towards the triangle and past its edges.
+    let mut r = Pcg32::new(9, 4);
+    for (name, shape) in test_shapes() {
+        let Shape::Triangle(tri) = &shape else { continue };
+        let sampler = tri.sampler();
+        let c = shape.bounds().centroid();
+        let (mut hits, mut misses) = (0, 0);
+        for k in 0..2000 {
+            let ctx = ShapeSampleContext::from_point(c + dir(&mut r) * [0.3, 2.0, 8.0][k % 3]);
+            let target = c + dir(&mut r) * 0.8;
+            let wi = target - ctx.p;
+            let (mine, theirs) = (sampler.pdf_from(&ctx, wi).0, shape.pdf_from(&ctx, wi).0);
+            if theirs == 0.0 {
+                misses += 1;
+                assert_eq!(mine, 0.0, "{name}");
+            } else {
+                hits += 1;
+                assert!((mine / theirs - 1.0).abs() < 1e-5, "{name}: {mine} vs {theirs}");
+            }
+        }
+        assert!(hits > 200 && misses > 200, "{name}: {hits} hits, {misses} misses");
+    }
+}
+
 /// Mean and standard error of E[1/pdf] over `n` solid-angle samples (misses count 0).
 fn mc_solid_angle(shape: &Shape, ctx: &ShapeSampleContext, n: usize, seed: u64) -> (f64, f64) {
     let mut r = Pcg32::new(seed, 1);

@@ -13,10 +13,10 @@
 //!
 //! Zero-area triangles have a zero determinant and are never hit.
 
-use super::{ShapeIntersection, ShapeSample, TriangleMesh};
+use super::{ShapeIntersection, ShapeSample, ShapeSampleContext, TriangleMesh};
 use crate::interaction::{Interaction, SurfaceInteraction};
 use crate::math::{gamma, Bounds3, Frame, Ray, Vec2, Vec3, Vec3A};
-use crate::sampling::{sample_uniform_triangle, PdfArea};
+use crate::sampling::{pdf_area_to_solid_angle, sample_uniform_triangle, PdfArea, PdfSolidAngle};
 use std::sync::Arc;
 
 /// Barycentrics and ray parameter of a ray–triangle hit.
@@ -404,6 +404,34 @@ impl TriangleSampler {
             intr,
             pdf: PdfArea(1.0 / area),
         })
+    }
+
+    /// Density of [`Self::sample_area`] by solid angle at `ctx` for direction
+    /// `wi`, 0 when the ray misses: [`Shape::pdf_from`] for a triangle
+    /// without building the hit's surface interaction (the same hit point,
+    /// normal and arithmetic, so the same value).
+    ///
+    /// [`Shape::pdf_from`]: super::Shape::pdf_from
+    pub fn pdf_from(&self, ctx: &ShapeSampleContext, wi: Vec3) -> PdfSolidAngle {
+        let [p0, p1, p2] = self.p;
+        let Some(ti) = intersect_triangle(&ctx.spawn_ray(wi), f32::INFINITY, p0, p1, p2) else {
+            return PdfSolidAngle(0.0);
+        };
+        let b = ti.b;
+        let p =
+            Vec3::from(b[0] * Vec3A::from(p0) + b[1] * Vec3A::from(p1) + b[2] * Vec3A::from(p2));
+        let cos = self.n.dot(wi.normalize()).abs();
+        let pdf = pdf_area_to_solid_angle(PdfArea(1.0 / self.area), ctx.p.distance_squared(p), cos);
+        if pdf.0.is_finite() {
+            pdf
+        } else {
+            PdfSolidAngle(0.0)
+        }
+    }
+
+    /// Area density of [`Self::sample_area`]: 1/A.
+    pub fn pdf_area(&self) -> PdfArea {
+        PdfArea(1.0 / self.area)
     }
 
     /// The geometric normal at barycentrics `b`, oriented as pbrt-v4 does:
