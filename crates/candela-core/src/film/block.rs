@@ -75,8 +75,18 @@ impl PassBlock {
         self.dropped += tile.dropped;
     }
 
-    /// Adds a splat buffer to the direct channels of the main (spectral,
-    /// photometric) layers.
+    /// Block pixel indices of the pixels `lo..hi` (within the block), row by row.
+    fn pixels_of(&self, lo: UVec2, hi: UVec2) -> impl Iterator<Item = usize> {
+        debug_assert!(lo.cmpge(self.lo).all() && hi.cmple(self.hi).all());
+        let (origin, width) = (self.lo, (self.hi.x - self.lo.x) as usize);
+        (lo.y..hi.y).flat_map(move |y| {
+            let i0 = (y - origin.y) as usize * width + (lo.x - origin.x) as usize;
+            i0..i0 + (hi.x - lo.x) as usize
+        })
+    }
+
+    /// Adds a splat buffer (over the block's pixels or a part of them) to
+    /// the direct channels of the main (spectral, photometric) layers.
     pub fn add_splats(&mut self, buf: &SplatBuffer) {
         let nb = self.layout.n_buckets();
         let (direct, spectral) = (
@@ -85,8 +95,8 @@ impl PassBlock {
         );
         let luminance = buf.luminance.filter(|_| self.layout.photometric);
         let dy = self.layout.photometric_offset() + super::layout::photo::DY;
-        for i in 0..self.pixel_count() {
-            let (row, src) = (i * self.stride, i * buf.stride);
+        for (j, i) in self.pixels_of(buf.lo, buf.hi).enumerate() {
+            let (row, src) = (i * self.stride, j * buf.stride);
             for k in 0..3 {
                 self.rows[row + direct + k] += buf.sums[src + k];
             }

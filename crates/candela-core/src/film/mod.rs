@@ -15,6 +15,7 @@
 //! Monte Carlo estimate of XYZ times the imaging ratio), clamped to
 //! `maxcomponentvalue`, and added with its filter weight.
 
+mod bands;
 mod block;
 pub mod develop;
 pub mod filter;
@@ -23,6 +24,7 @@ pub mod layout;
 mod state;
 mod tile;
 
+pub use bands::{BandRows, SplatBands};
 pub use block::PassBlock;
 pub use develop::{Channel, Developed};
 pub use layout::{Aov, Buckets, FilmLayout, SurfaceAov};
@@ -208,6 +210,11 @@ impl Film {
     /// An empty splat buffer over the pixel bounds.
     pub fn splat_buffer(&self) -> SplatBuffer {
         let (lo, hi) = self.settings.pixel_bounds;
+        SplatBuffer::new(lo, hi, self.filter.clone(), self.encoder())
+    }
+
+    /// An empty splat buffer over the pixels `lo..hi` (within the pixel bounds).
+    pub fn splat_buffer_over(&self, lo: UVec2, hi: UVec2) -> SplatBuffer {
         SplatBuffer::new(lo, hi, self.filter.clone(), self.encoder())
     }
 

@@ -246,6 +246,24 @@ pub struct SplatRecord {
     lambda: SampledWavelengths,
 }
 
+impl SplatRecord {
+    /// A splat of `l` at raster position `p`.
+    #[cfg(test)]
+    pub(crate) fn new(p: Vec2, l: SampledSpectrum, lambda: SampledWavelengths) -> Self {
+        Self { p, l, lambda }
+    }
+
+    /// The raster position.
+    pub(crate) fn position(&self) -> Vec2 {
+        self.p
+    }
+
+    /// True when the value is not finite ([`SplatBuffer::add`] drops it).
+    pub(crate) fn is_dropped(&self) -> bool {
+        self.l.has_non_finite()
+    }
+}
+
 impl SplatBuffer {
     pub(crate) fn new(lo: UVec2, hi: UVec2, filter: Filter, enc: Encoder) -> Self {
         let spectral = 3 + enc.buckets.map_or(0, |b| b.n);

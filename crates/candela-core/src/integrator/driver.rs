@@ -6,18 +6,20 @@
 //! any thread count and schedule.
 //!
 //! Estimators that splat (BDPT's t = 1 strategies) record their splats per
-//! tile; they are summed into one of [`LANES`] splat buffers over the pixel
-//! bounds, tile i into lane i mod LANES, the tiles of a lane in order (the
-//! lanes in parallel), and lanes are added to the block in order, so splat
-//! sums do not depend on the thread count either. Tiles, not lanes, are
-//! the tasks: with lanes as tasks two threads shared eight units of work
-//! per pass and waited for each other at its end (from one thread to two
-//! on the Cornell box, `bench/peers_speed.py --cases scaling`: the path
-//! tracer 1.60× with lanes, 1.92× with tiles; BDPT 1.68×, 1.89×).
+//! tile; they are summed by horizontal bands of the film in tile order
+//! ([`crate::film::SplatBands`]), so splat sums do not depend on the thread
+//! count either. (Until stop 37 tile i went to one of eight lanes, i mod 8,
+//! each a buffer over the whole film: 12.6 MB made, zeroed and added to the
+//! block per pass at 256², on the Cornell box's BDPT four fifths of the
+//! process's page faults.) Tiles are the rendering tasks: with eight lanes
+//! as tasks two threads shared eight units of work per pass and waited for
+//! each other at its end (from one thread to two on the Cornell box,
+//! `bench/peers_speed.py --cases scaling`: the path tracer 1.60× with lanes,
+//! 1.92× with tiles; BDPT 1.68×, 1.89×).
 
 use super::{PassOutcome, PixelEstimator, RenderContext};
 use crate::camera::CameraSample;
-use crate::film::{FilmTile, PassBlock, SplatBuffer, SplatRecord};
+use crate::film::{BandRows, FilmTile, PassBlock, SplatBands, SplatBuffer, SplatRecord};
 use crate::math::{UVec2, Vec2};
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
@@ -25,8 +27,11 @@ use rayon::prelude::*;
 
 /// Tile side in pixels.
 pub const TILE: u32 = 16;
-/// Splat lanes (fixed, so splat sums do not depend on the thread count).
+/// Fixed lanes of work for the light-path passes (light tracing, VCM's
+/// light subpaths), so their sums do not depend on the thread count.
 pub const LANES: usize = 8;
+/// Horizontal bands of the film that sum a pass's splats in parallel.
+pub const BANDS: usize = 8;
 
 /// Renders sample `pass` of every pixel with `est` into `block`.
 pub fn render_pixels(
@@ -41,34 +46,41 @@ pub fn render_pixels(
     // splat per pixel sample (BDPT makes one per light vertex that sees the
     // lens). A batch is enough tiles that its end idles a thread for at most
     // one tile of 256 per thread.
-    const BATCH: usize = 64 * LANES;
-    let mut lanes: Vec<Option<SplatBuffer>> = (0..LANES).map(|_| None).collect();
-    for (b, batch) in tiles.chunks(BATCH).enumerate() {
-        let Some(done) = render_batch(est, ctx, pass, batch) else {
+    const BATCH: usize = 512;
+    let rows = BandRows::new(ctx.film, BANDS);
+    let mut bands: Option<SplatBands> = None;
+    for batch in tiles.chunks(BATCH) {
+        let Some(done) = render_batch(est, ctx, pass, batch, &rows) else {
             return PassOutcome::Cancelled;
         };
         for (tile, _) in &done {
             block.add_tile(tile);
         }
-        if est.splats() {
-            replay_lanes(ctx, &mut lanes, b * BATCH, &done);
+        if done
+            .iter()
+            .any(|(_, split)| split.iter().any(|r| !r.is_empty()))
+        {
+            bands
+                .get_or_insert_with(|| SplatBands::new(ctx.film, &rows))
+                .replay(done.iter().map(|(_, split)| split.as_slice()));
         }
     }
-    for buf in lanes.iter().flatten() {
+    for buf in bands.iter().flat_map(|b| b.buffers()) {
         block.add_splats(buf);
     }
     PassOutcome::Done
 }
 
 /// The tiles of `batch`, each a task of its own, with the splats each
-/// recorded, in the batch's order whatever thread rendered them; `None` if
-/// the render was cancelled.
+/// recorded split by the bands of `rows`, in the batch's order whatever
+/// thread rendered them; `None` if the render was cancelled.
 fn render_batch(
     est: &dyn PixelEstimator,
     ctx: &RenderContext<'_>,
     pass: u64,
     batch: &[(UVec2, UVec2)],
-) -> Option<Vec<(FilmTile, Vec<SplatRecord>)>> {
+    rows: &BandRows,
+) -> Option<Vec<(FilmTile, Vec<Vec<SplatRecord>>)>> {
     batch
         .par_iter()
         .map_init(
@@ -79,30 +91,10 @@ fn render_batch(
                 }
                 let tile = render_tile(est, ctx, pass, lo, hi, rec);
                 ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
-                Some((tile, rec.take_records()))
+                Some((tile, rows.split(&rec.take_records())))
             },
         )
         .collect()
-}
-
-/// Adds the splats of the tiles `done` (the first of them tile `first` of
-/// the pass) to the lanes, tile i to lane i mod [`LANES`] in tile order,
-/// the lanes in parallel (module doc).
-fn replay_lanes(
-    ctx: &RenderContext<'_>,
-    lanes: &mut [Option<SplatBuffer>],
-    first: usize,
-    done: &[(FilmTile, Vec<SplatRecord>)],
-) {
-    lanes.par_iter_mut().enumerate().for_each(|(lane, buf)| {
-        let skip = (lane + LANES - first % LANES) % LANES;
-        for (_, records) in done.iter().skip(skip).step_by(LANES) {
-            if !records.is_empty() {
-                buf.get_or_insert_with(|| ctx.film.splat_buffer())
-                    .replay(records);
-            }
-        }
-    });
 }
 
 /// Runs `f` on every tile of the film in parallel; the results come back in

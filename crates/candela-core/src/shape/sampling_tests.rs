@@ -301,7 +301,9 @@ fn triangle_sampler_density_is_the_shapes() {
     // own `pdf_from`, towards the triangle and past its edges.
     let mut r = Pcg32::new(9, 4);
     for (name, shape) in test_shapes() {
-        let Shape::Triangle(tri) = &shape else { continue };
+        let Shape::Triangle(tri) = &shape else {
+            continue;
+        };
         let sampler = tri.sampler();
         let c = shape.bounds().centroid();
         let (mut hits, mut misses) = (0, 0);
@@ -315,10 +317,16 @@ fn triangle_sampler_density_is_the_shapes() {
                 assert_eq!(mine, 0.0, "{name}");
             } else {
                 hits += 1;
-                assert!((mine / theirs - 1.0).abs() < 1e-5, "{name}: {mine} vs {theirs}");
+                assert!(
+                    (mine / theirs - 1.0).abs() < 1e-5,
+                    "{name}: {mine} vs {theirs}"
+                );
             }
         }
-        assert!(hits > 200 && misses > 200, "{name}: {hits} hits, {misses} misses");
+        assert!(
+            hits > 200 && misses > 200,
+            "{name}: {hits} hits, {misses} misses"
+        );
     }
 }
 
