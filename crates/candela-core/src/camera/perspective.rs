@@ -13,7 +13,7 @@
 use super::{check_lens, CameraError, CameraFrame, CameraParams, CameraRay, CameraSample};
 use super::{CameraWiSample, ScreenMap};
 use crate::interaction::Interaction;
-use crate::math::{Ray, Vec2, Vec3, PI};
+use crate::math::{Mat3, Ray, Vec2, Vec3, PI};
 use crate::sampling::{pdf_area_to_solid_angle, sample_uniform_disk_concentric};
 use crate::sampling::{PdfArea, PdfSolidAngle};
 
@@ -29,6 +29,10 @@ pub struct PerspectiveCamera {
     area: f32,
     /// The lens point of a pinhole (the camera's position), made once.
     pinhole: Interaction,
+    /// For a pinhole, world direction d to homogeneous raster position:
+    /// (h.x, h.y)/h.z is where the ray from the pinhole along d meets the
+    /// film ([`Self::pinhole_raster`]).
+    raster_from_dir: Mat3,
 }
 
 impl PerspectiveCamera {
@@ -42,6 +46,7 @@ impl PerspectiveCamera {
         let tan_half_fov = (0.5 * p.fov_deg.to_radians()).tan();
         let frame = CameraFrame::new(p.camera_from_world);
         Ok(Self {
+            raster_from_dir: raster_from_dir(&frame, &screen, tan_half_fov),
             pinhole: frame.lens_interaction(Vec3::ZERO),
             frame,
             screen,
@@ -92,15 +97,26 @@ impl PerspectiveCamera {
         if cos_theta <= 0.0 || cos_theta.is_nan() {
             return None;
         }
-        // Where the ray meets the plane of focus (z = 1 for a pinhole).
-        let z = if self.lens_radius > 0.0 {
-            self.focal_distance
-        } else {
-            1.0
-        };
+        if self.lens_radius == 0.0 {
+            return self.pinhole_raster(d).map(|r| (cos_theta, r));
+        }
+        // Where the ray meets the plane of focus.
+        let z = self.focal_distance;
         let pc = self.frame.camera_from_world.point(o + d * (z / cos_theta));
         let s = Vec2::new(pc.x, pc.y) / (pc.z * self.tan_half_fov);
         Some((cos_theta, self.screen.screen_to_raster(s)))
+    }
+
+    /// Raster position of the ray from the pinhole along `d`: with p_c =
+    /// M·d + (the camera's position in camera space, 0) for the linear part M
+    /// of camera-from-world, the screen point is p_c.xy/(p_c.z tan(fov/2))
+    /// whatever the distance along the ray, and screen to raster is affine,
+    /// so one 3×3 map and a division give it (`raster_from_dir`). `None`
+    /// behind the camera.
+    #[inline]
+    fn pinhole_raster(&self, d: Vec3) -> Option<Vec2> {
+        let h = self.raster_from_dir * d;
+        (h.z > 0.0).then(|| Vec2::new(h.x, h.y) / h.z)
     }
 
     /// W_e = 1/(A · lens area · cos⁴θ) inside the film sample bounds.
@@ -157,4 +173,20 @@ impl PerspectiveCamera {
             is_delta: false,
         })
     }
+}
+
+/// The map of [`PerspectiveCamera::pinhole_raster`]: rows k_x(M₀/t − x₀M₂),
+/// k_y(y₁M₂ − M₁/t) and M₂, from the rows Mᵢ of camera-from-world's linear
+/// part, t = tan(fov/2), the screen window's x₀ (left) and y₁ (top), and
+/// k = resolution / window extent [pbrt-v4 §5.2.3, raster from screen].
+fn raster_from_dir(frame: &CameraFrame, screen: &ScreenMap, tan_half_fov: f32) -> Mat3 {
+    let m = Mat3::from_mat4(frame.camera_from_world.m);
+    let (m0, m1, m2) = (m.row(0), m.row(1), m.row(2));
+    let k = screen.res / (screen.win_max - screen.win_min);
+    Mat3::from_cols(
+        k.x * (m0 / tan_half_fov - screen.win_min.x * m2),
+        k.y * (screen.win_max.y * m2 - m1 / tan_half_fov),
+        m2,
+    )
+    .transpose()
 }
