@@ -7,7 +7,9 @@ use crate::camera::{Camera, CameraParams, SphericalCamera, SphericalMapping};
 use crate::film::filter::{Filter, FilterKind, FilterParams};
 use crate::film::{Buckets, Film, FilmKind, FilmLayout, FilmSettings, SurfaceAov, SurfaceSpace};
 use crate::math::{Transform, UVec2, Vec2};
-use crate::sampler::{HaltonRandomize, HaltonSampler, Sampler, SamplerKind};
+use crate::sampler::{
+    HaltonRandomize, HaltonSampler, Sampler, SamplerKind, ZSobolRandomize, ZSobolSampler,
+};
 use crate::spectrum::{ColorSpace, PixelSensor, LAMBDA_MAX, LAMBDA_MIN};
 use candela_scene::SceneDescription;
 use std::path::PathBuf;
@@ -380,15 +382,36 @@ pub fn sampler(
             e.loc, e.name, kind
         ));
     }
-    if kind == SamplerKind::Halton {
-        return Ok(Sampler::Halton(HaltonSampler::new(
+    match kind {
+        SamplerKind::Halton => Ok(Sampler::Halton(HaltonSampler::new(
             spp,
             seed,
             resolution,
             halton_randomize(&ck)?,
-        )));
+        ))),
+        SamplerKind::ZSobol => Ok(Sampler::ZSobol(ZSobolSampler::new(
+            spp,
+            seed,
+            resolution,
+            zsobol_randomize(&ck)?,
+        ))),
+        _ => Ok(Sampler::new(kind, spp, seed)),
     }
-    Ok(Sampler::new(kind, spp, seed))
+}
+
+/// `Sampler "zsobol"`'s `"string randomization"` (pbrt-v4's names and
+/// default, `fastowen`).
+fn zsobol_randomize(ck: &Check<'_>) -> Result<ZSobolRandomize, BuildError> {
+    let name = ck.params.get_string("randomization", "fastowen")?;
+    ZSobolRandomize::from_name(&name).ok_or_else(|| {
+        ck.error(
+            "randomization",
+            format!(
+                "\"{name}\" is not supported by the ZSobol sampler (supported: {})",
+                ZSobolRandomize::NAMES
+            ),
+        )
+    })
 }
 
 /// `Sampler "halton"`'s `"string randomization"` (pbrt-v4's names;

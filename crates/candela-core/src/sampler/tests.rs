@@ -2,10 +2,11 @@
 
 use super::*;
 
-const KINDS: [SamplerKind; 3] = [
+const KINDS: [SamplerKind; 4] = [
     SamplerKind::Independent,
     SamplerKind::PaddedSobol,
     SamplerKind::Halton,
+    SamplerKind::ZSobol,
 ];
 
 /// The first `dims` values (alternating 1D and 2D requests) of one pixel sample.
@@ -96,12 +97,77 @@ fn padded_sobol_2d_requests_are_nets() {
                     .collect();
                 assert_eq!(
                     is_02_net(&pts),
-                    kind == SamplerKind::PaddedSobol,
+                    matches!(kind, SamplerKind::PaddedSobol | SamplerKind::ZSobol),
                     "{kind:?} {spp}"
                 );
             }
         }
     }
+}
+
+/// ZSobol's samples of every aligned square of pixels form one net too (the
+/// blue-noise property, module doc of `zsobol`): 2×2 pixels of 16 samples,
+/// 4×4 of 4 and 2×2 of 8 (odd log2 spp: binary lowest digit), at several
+/// squares and requests, over films whose side is and is not a power of
+/// two; padded Sobol's independent pixels are not (the test can fail).
+#[test]
+fn zsobol_squares_of_pixels_are_nets() {
+    for (spp, side, film) in [(16u32, 2u32, 256u32), (4, 4, 100), (8, 2, 640)] {
+        for kind in [SamplerKind::ZSobol, SamplerKind::PaddedSobol] {
+            let mut s = match kind {
+                SamplerKind::ZSobol => Sampler::ZSobol(ZSobolSampler::new(
+                    spp,
+                    3,
+                    UVec2::new(film, film / 2 + 1),
+                    ZSobolRandomize::FastOwen,
+                )),
+                _ => Sampler::new(kind, spp, 3),
+            };
+            for (corner, request) in [
+                (UVec2::new(0, 0), 0),
+                (UVec2::new(8, 4), 1),
+                (UVec2::new(36, 20), 5),
+            ] {
+                let mut pts = Vec::new();
+                for dy in 0..side {
+                    for dx in 0..side {
+                        for i in 0..spp {
+                            s.start_pixel_sample(corner + UVec2::new(dx, dy), i, 2 * request);
+                            pts.push(s.get_2d());
+                        }
+                    }
+                }
+                assert_eq!(
+                    is_02_net(&pts),
+                    kind == SamplerKind::ZSobol,
+                    "{kind:?} {spp} spp, {side}² pixels at {corner}"
+                );
+            }
+        }
+    }
+}
+
+/// Every ZSobol randomisation keeps the nets of a pixel, and the passes of
+/// a second epoch (sample indices ≥ spp) are a net again, but a different one.
+#[test]
+fn zsobol_randomizations_and_epochs_keep_nets() {
+    for r in ["none", "permutedigits", "fastowen", "owen"] {
+        let randomize = ZSobolRandomize::from_name(r).expect("a pbrt-v4 name");
+        let mut s = ZSobolSampler::new(16, 9, UVec2::new(64, 64), randomize);
+        let pixel = UVec2::new(5, 6);
+        let pts = |s: &mut ZSobolSampler, first: u32| -> Vec<Vec2> {
+            (first..first + 16)
+                .map(|i| {
+                    s.start_pixel_sample(pixel, i, 4);
+                    s.get_2d()
+                })
+                .collect()
+        };
+        let (a, b) = (pts(&mut s, 0), pts(&mut s, 16));
+        assert!(is_02_net(&a) && is_02_net(&b), "{r}");
+        assert_ne!(a, b, "{r}");
+    }
+    assert_eq!(ZSobolRandomize::from_name("sobol"), None);
 }
 
 /// Mean over many dimensions is 1/2 and neighbouring dimensions are
@@ -145,7 +211,11 @@ fn pbrt_names_map_to_samplers() {
         SamplerKind::from_name("halton"),
         Some((SamplerKind::Halton, true))
     );
-    for n in ["zsobol", "sobol", "pmj02bn", "stratified"] {
+    assert_eq!(
+        SamplerKind::from_name("zsobol"),
+        Some((SamplerKind::ZSobol, true))
+    );
+    for n in ["sobol", "pmj02bn", "stratified"] {
         assert_eq!(
             SamplerKind::from_name(n),
             Some((SamplerKind::PaddedSobol, false))
