@@ -11,7 +11,7 @@
 //! once.
 
 use super::tile::{SplatBuffer, SplatRecord};
-use super::Film;
+use super::{Film, PassBlock};
 use crate::math::UVec2;
 use rayon::prelude::*;
 
@@ -92,6 +92,53 @@ impl BandRows {
             }
         }
         out
+    }
+}
+
+/// A pass's splats by band: the rows, and the band buffers once a splat
+/// comes (estimators that never splat allocate nothing).
+pub struct PassSplats {
+    rows: BandRows,
+    bands: Option<SplatBands>,
+}
+
+impl PassSplats {
+    /// No splats yet, over `n` bands of `film`.
+    pub fn new(film: &Film, n: usize) -> Self {
+        Self {
+            rows: BandRows::new(film, n),
+            bands: None,
+        }
+    }
+
+    /// The bands' rows, to split records by ([`BandRows::split`]).
+    pub fn rows(&self) -> &BandRows {
+        &self.rows
+    }
+
+    /// Adds tasks' records, each task's split by band, in the order of `tasks`.
+    pub fn add<'a>(
+        &mut self,
+        film: &Film,
+        tasks: impl Iterator<Item = &'a [Vec<SplatRecord>]> + Clone + Send + Sync,
+    ) {
+        if tasks
+            .clone()
+            .all(|split| split.iter().all(|r| r.is_empty()))
+        {
+            return;
+        }
+        let rows = &self.rows;
+        self.bands
+            .get_or_insert_with(|| SplatBands::new(film, rows))
+            .replay(tasks);
+    }
+
+    /// Adds the sums to `block`'s direct channels.
+    pub fn add_to(&self, block: &mut PassBlock) {
+        for buf in self.bands.iter().flat_map(|b| b.buffers()) {
+            block.add_splats(buf);
+        }
     }
 }
 

@@ -24,7 +24,7 @@ pub mod layout;
 mod state;
 mod tile;
 
-pub use bands::{BandRows, SplatBands};
+pub use bands::{BandRows, PassSplats, SplatBands};
 pub use block::PassBlock;
 pub use develop::{Channel, Developed};
 pub use layout::{Aov, Buckets, FilmLayout, SurfaceAov};

@@ -19,7 +19,7 @@
 
 use super::{PassOutcome, PixelEstimator, RenderContext};
 use crate::camera::CameraSample;
-use crate::film::{BandRows, FilmTile, PassBlock, SplatBands, SplatBuffer, SplatRecord};
+use crate::film::{BandRows, FilmTile, PassBlock, PassSplats, SplatBuffer, SplatRecord};
 use crate::math::{UVec2, Vec2};
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
@@ -47,29 +47,57 @@ pub fn render_pixels(
     // lens). A batch is enough tiles that its end idles a thread for at most
     // one tile of 256 per thread.
     const BATCH: usize = 512;
-    let rows = BandRows::new(ctx.film, BANDS);
-    let mut bands: Option<SplatBands> = None;
+    let mut splats = PassSplats::new(ctx.film, BANDS);
     for batch in tiles.chunks(BATCH) {
-        let Some(done) = render_batch(est, ctx, pass, batch, &rows) else {
+        let Some(done) = render_batch(est, ctx, pass, batch, splats.rows()) else {
             return PassOutcome::Cancelled;
         };
         for (tile, _) in &done {
             block.add_tile(tile);
         }
-        if done
-            .iter()
-            .any(|(_, split)| split.iter().any(|r| !r.is_empty()))
-        {
-            bands
-                .get_or_insert_with(|| SplatBands::new(ctx.film, &rows))
-                .replay(done.iter().map(|(_, split)| split.as_slice()));
-        }
+        splats.add(ctx.film, done.iter().map(|(_, split)| split.as_slice()));
     }
-    for buf in bands.iter().flat_map(|b| b.buffers()) {
-        block.add_splats(buf);
-    }
+    splats.add_to(block);
     PassOutcome::Done
 }
+
+/// Runs tasks `0..n_tasks` in parallel, `task(i, recorder)` recording its
+/// splats, and adds the splats to `block` in task order (by bands, so the
+/// sums do not depend on the thread count); tasks run [`BATCH_TASKS`] at a
+/// time, so only a batch's records are held.
+pub fn splat_tasks(
+    ctx: &RenderContext<'_>,
+    block: &mut PassBlock,
+    n_tasks: u64,
+    task: impl Fn(u64, &mut SplatBuffer) + Sync,
+) -> PassOutcome {
+    let mut splats = PassSplats::new(ctx.film, BANDS);
+    for first in (0..n_tasks).step_by(BATCH_TASKS as usize) {
+        let rows = splats.rows();
+        let done: Option<Vec<Vec<Vec<SplatRecord>>>> = (first..(first + BATCH_TASKS).min(n_tasks))
+            .into_par_iter()
+            .map_init(
+                || SplatBuffer::recording(ctx.film),
+                |rec, i| {
+                    if ctx.cancelled() {
+                        return None;
+                    }
+                    task(i, rec);
+                    Some(rows.split(&rec.take_records()))
+                },
+            )
+            .collect();
+        let Some(done) = done else {
+            return PassOutcome::Cancelled;
+        };
+        splats.add(ctx.film, done.iter().map(|split| split.as_slice()));
+    }
+    splats.add_to(block);
+    PassOutcome::Done
+}
+
+/// Tasks of [`splat_tasks`] per batch.
+pub const BATCH_TASKS: u64 = 128;
 
 /// The tiles of `batch`, each a task of its own, with the splats each
 /// recorded split by the bands of `rows`, in the batch's order whatever

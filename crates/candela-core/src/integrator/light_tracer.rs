@@ -14,10 +14,11 @@
 //! correction |wo·ns||wi·ng| / (|wo·ng||wi·ns|) is applied at every
 //! scattering and connection [Veach 1997, eq. 5.19].
 //!
-//! Paths are processed in chunks assigned to a fixed number of splat lanes,
-//! added in lane order: the image is bit-identical for any thread count.
+//! Paths are processed in chunks, each a task that records its splats; they
+//! are summed in chunk order ([`driver::splat_tasks`]): the image is
+//! bit-identical for any thread count.
 
-use super::driver::LANES;
+use super::driver;
 use super::roulette::Roulette;
 use super::subpath::{start_light_subpath, walk, Dispersion, Flow, Vertex, Visitor, Walk};
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
@@ -27,10 +28,11 @@ use crate::interaction::SurfaceInteraction;
 use crate::math::Vec2;
 use crate::sampling::{hash_u64s, PathRng, StreamRng};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use rayon::prelude::*;
 
-/// Paths per work item.
-const PATHS_PER_CHUNK: u64 = 1 << 14;
+/// Paths per task: 64 tasks a pass at 256² (the last ones of a pass idle a
+/// thread for at most one task), their splats recorded (56 bytes each) and
+/// summed in task order ([`driver::splat_tasks`]).
+const PATHS_PER_CHUNK: u64 = 1 << 10;
 
 /// Parameters of `Integrator "lightpath"`.
 #[derive(Clone, Debug)]
@@ -73,31 +75,13 @@ impl Integrator for LightTracer {
     ) -> PassOutcome {
         let n = paths_per_pass(ctx);
         let first = pass * n;
-        let n_chunks = n.div_ceil(PATHS_PER_CHUNK);
-        let lanes: Vec<SplatBuffer> = (0..LANES as u64)
-            .into_par_iter()
-            .map(|lane| {
-                let mut buf = ctx.film.splat_buffer();
-                for c in (lane..n_chunks).step_by(LANES) {
-                    if ctx.cancelled() {
-                        break;
-                    }
-                    let end = ((c + 1) * PATHS_PER_CHUNK).min(n);
-                    for i in c * PATHS_PER_CHUNK..end {
-                        self.trace_path(ctx, first + i, &mut buf);
-                    }
-                    ctx.advance(end - c * PATHS_PER_CHUNK);
-                }
-                buf
-            })
-            .collect();
-        if ctx.cancelled() {
-            return PassOutcome::Cancelled;
-        }
-        for b in &lanes {
-            block.add_splats(b);
-        }
-        PassOutcome::Done
+        driver::splat_tasks(ctx, block, n.div_ceil(PATHS_PER_CHUNK), |c, rec| {
+            let end = ((c + 1) * PATHS_PER_CHUNK).min(n);
+            for i in c * PATHS_PER_CHUNK..end {
+                self.trace_path(ctx, first + i, rec);
+            }
+            ctx.advance(end - c * PATHS_PER_CHUNK);
+        })
     }
 }
 
