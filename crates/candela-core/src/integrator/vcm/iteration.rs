@@ -8,7 +8,7 @@ use super::merge::MergeGrid;
 use super::mis::Factors;
 use super::variance::{ByLength, LtWeights};
 use super::VcmIntegrator;
-use crate::film::{FilmTile, SplatBuffer};
+use crate::film::{FilmTile, PassSplats};
 use crate::integrator::driver::for_each_tile;
 use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::RenderContext;
@@ -19,7 +19,7 @@ use std::sync::atomic::Ordering;
 /// path length when asked for.
 pub(super) struct Iteration {
     /// Light tracing's splats.
-    pub splats: Vec<SplatBuffer>,
+    pub splats: PassSplats,
     /// The camera pass's tiles.
     pub tiles: Vec<FilmTile>,
     /// Every pixel's camera-side estimate by path length (`record`).
@@ -47,7 +47,7 @@ impl VcmIntegrator {
         let time = self.time(ctx, pass);
         let mut light = self.light_pass(ctx, pass, &lambda, time, &f, Some(lt))?;
         self.stored.store(light.len() as u64, Ordering::Relaxed);
-        let splats = std::mem::take(&mut light.splats);
+        let splats = std::mem::replace(&mut light.splats, PassSplats::new(ctx.film, 1));
         if t.light_only {
             light.recycle(&self.pools.chunks);
             return Some(Iteration {

@@ -8,21 +8,23 @@
 //! scattering ([`Scatter`]) before the next hit, whose direction gives the
 //! geometric outgoing cosine at the previous vertex; the update of eqs.
 //! 34–36 is applied there, then the arrival (distance², cosine) of the new
-//! vertex. Chunks of paths run on [`LANES`] fixed lanes and are put back in
-//! path order, so the stored vertices and splats do not depend on the
-//! thread count. The vertices stay in the chunk that made them
-//! ([`LightPaths::path`] finds a path's), and chunk and splat buffers are
-//! reused by the next iteration (`Pool`): copying the chunks into one
-//! array, into freshly faulted pages, was a serial memcpy of ~12 MB per
-//! iteration at 128².
+//! vertex. Every chunk of [`CHUNK`] paths is a task; the chunks are kept in
+//! path order and their splats summed in that order by the film's bands
+//! ([`PassSplats`]), so the stored vertices and splats do not depend on the
+//! thread count. (Until stop 37 chunks of 4096 ran on eight fixed lanes,
+//! each with a splat buffer over the whole film: at 128² four tasks for two
+//! threads.) The vertices stay in the chunk that made them
+//! ([`LightPaths::path`] finds a path's), and chunks are reused by the next
+//! iteration (`Pool`): copying the chunks into one array, into freshly
+//! faulted pages, was a serial memcpy of ~12 MB per iteration at 128².
 
 use super::densities::light_densities;
 use super::mis::{thin, weight, Deferred, DirectMerges, Factors, Partial};
 use super::variance::LtWeights;
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
-use crate::film::SplatBuffer;
-use crate::integrator::driver::LANES;
+use crate::film::{PassSplats, SplatBuffer, SplatRecord};
+use crate::integrator::driver::{BANDS, BATCH_TASKS};
 use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
@@ -122,9 +124,9 @@ impl PrevVertex {
     }
 }
 
-/// Light paths per chunk: the unit of parallel work of the light pass and
-/// of storage.
-pub(super) const CHUNK: usize = 4096;
+/// Light paths per chunk: the unit of parallel work of the light pass (a
+/// task, run [`BATCH_TASKS`] at a time) and of storage.
+pub(super) const CHUNK: usize = 1024;
 
 /// The stored vertices of [`CHUNK`] consecutive light paths.
 #[derive(Default)]
@@ -141,7 +143,7 @@ pub(super) struct PathChunk {
 pub struct LightPaths {
     chunks: Vec<PathChunk>,
     /// The light-tracing splats (already scaled to one path per pixel).
-    pub splats: Vec<SplatBuffer>,
+    pub splats: PassSplats,
 }
 
 impl LightPaths {
@@ -214,24 +216,6 @@ impl Pool<PathChunk> {
     }
 }
 
-impl Pool<SplatBuffer> {
-    /// A zero splat buffer over the film's pixels, reusing an earlier one.
-    fn splats(&self, ctx: &RenderContext<'_>) -> SplatBuffer {
-        let (lo, hi) = ctx.film.pixel_bounds();
-        match self.take() {
-            Some(mut b) if b.covers(lo, hi) => {
-                b.clear();
-                b
-            }
-            _ => ctx.film.splat_buffer(),
-        }
-    }
-}
-
-/// What one parallel lane of a light pass returns: its splat buffer (when
-/// it splats) and its chunks with their indices.
-type Lane = (Option<SplatBuffer>, Vec<(u64, PathChunk)>);
-
 impl VcmIntegrator {
     /// Walks the `n_light` light subpaths of pass `pass` at wavelengths
     /// `lambda` and time `time`, splatting their camera connections weighed
@@ -249,50 +233,37 @@ impl VcmIntegrator {
         let n = self.light_paths(ctx);
         let chunk = CHUNK as u64;
         let n_chunks = n.div_ceil(chunk);
-        let lanes: Vec<Lane> = (0..LANES as u64)
-            .into_par_iter()
-            .map(|lane| {
-                let mut buf = lt.is_some().then(|| self.pools.splats.splats(ctx));
-                let mut chunks = Vec::new();
-                for c in (lane..n_chunks).step_by(LANES) {
-                    if ctx.cancelled() {
-                        break;
-                    }
-                    let mut out = self.pools.chunks.chunk();
-                    let end = ((c + 1) * chunk).min(n);
-                    for i in c * chunk..end {
-                        self.trace_light(
-                            ctx,
-                            pass,
-                            i,
-                            lambda,
-                            time,
-                            f,
-                            &mut out.vertices,
-                            buf.as_mut().zip(lt),
-                        );
-                        out.ends.push(out.vertices.len() as u32);
-                    }
-                    ctx.advance(end - c * chunk);
-                    chunks.push((c, out));
-                }
-                (buf, chunks)
-            })
-            .collect();
-        if ctx.cancelled() {
-            return None;
+        let mut splats = PassSplats::new(ctx.film, BANDS);
+        let mut chunks = Vec::with_capacity(n_chunks as usize);
+        for first in (0..n_chunks).step_by(BATCH_TASKS as usize) {
+            let rows = splats.rows();
+            let done: Option<Vec<(PathChunk, Vec<Vec<SplatRecord>>)>> = (first
+                ..(first + BATCH_TASKS).min(n_chunks))
+                .into_par_iter()
+                .map_init(
+                    || lt.is_some().then(|| SplatBuffer::recording(ctx.film)),
+                    |rec, c| {
+                        if ctx.cancelled() {
+                            return None;
+                        }
+                        let mut out = self.pools.chunks.chunk();
+                        let end = ((c + 1) * chunk).min(n);
+                        for i in c * chunk..end {
+                            let buf = rec.as_mut().zip(lt);
+                            self.trace_light(ctx, pass, i, lambda, time, f, &mut out.vertices, buf);
+                            out.ends.push(out.vertices.len() as u32);
+                        }
+                        ctx.advance(end - c * chunk);
+                        let records = rec.as_mut().map(|r| r.take_records()).unwrap_or_default();
+                        Some((out, rows.split(&records)))
+                    },
+                )
+                .collect();
+            let done = done?;
+            splats.add(ctx.film, done.iter().map(|(_, split)| split.as_slice()));
+            chunks.extend(done.into_iter().map(|(c, _)| c));
         }
-        let mut splats = Vec::with_capacity(LANES);
-        let mut chunks = Vec::new();
-        for (buf, c) in lanes {
-            splats.extend(buf);
-            chunks.extend(c);
-        }
-        chunks.sort_by_key(|c| c.0);
-        Some(LightPaths {
-            chunks: chunks.into_iter().map(|(_, c)| c).collect(),
-            splats,
-        })
+        Some(LightPaths { chunks, splats })
     }
 
     /// Walks light path `i`, storing its vertices in `out` and splatting its

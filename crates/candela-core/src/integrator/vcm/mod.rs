@@ -367,7 +367,6 @@ pub struct VcmIntegrator {
 #[derive(Default)]
 struct Pools {
     chunks: light::Pool<light::PathChunk>,
-    splats: light::Pool<crate::film::SplatBuffer>,
 }
 
 impl VcmIntegrator {
@@ -491,10 +490,7 @@ impl Integrator for VcmIntegrator {
         let Some(it) = self.iteration(ctx, pass, lt, record) else {
             return PassOutcome::Cancelled;
         };
-        for b in &it.splats {
-            block.add_splats(b);
-        }
-        self.pools.splats.give(it.splats);
+        it.splats.add_to(block);
         for tile in &it.tiles {
             block.add_tile(tile);
         }

@@ -37,9 +37,7 @@ impl VcmIntegrator {
     pub(super) fn lt_weights(&self, ctx: &RenderContext<'_>) -> Option<&LtWeights> {
         let enabled = self.variance_pilot(ctx);
         self.pilot.weights(ctx, enabled, |quiet, pass| {
-            let it = self.iteration(quiet, pass, &NO_LT, true)?;
-            self.pools.splats.give(it.splats);
-            it.samples
+            self.iteration(quiet, pass, &NO_LT, true)?.samples
         })
     }
 }
