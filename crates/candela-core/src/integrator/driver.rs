@@ -16,6 +16,10 @@
 //! each other at its end (from one thread to two on the Cornell box,
 //! `bench/peers_speed.py --cases scaling`: the path tracer 1.60× with lanes,
 //! 1.92× with tiles; BDPT 1.68×, 1.89×).
+//!
+//! Passes that trace from the lights instead of the pixels (light tracing,
+//! VCM's light subpaths) split their paths into chunks, each a task, and
+//! sum the chunks' splats the same way in chunk order ([`splat_tasks`]).
 
 use super::{PassOutcome, PixelEstimator, RenderContext};
 use crate::camera::CameraSample;
@@ -27,9 +31,6 @@ use rayon::prelude::*;
 
 /// Tile side in pixels.
 pub const TILE: u32 = 16;
-/// Fixed lanes of work for the light-path passes (light tracing, VCM's
-/// light subpaths), so their sums do not depend on the thread count.
-pub const LANES: usize = 8;
 /// Horizontal bands of the film that sum a pass's splats in parallel.
 pub const BANDS: usize = 8;
 
