@@ -19,7 +19,7 @@ use std::sync::atomic::Ordering;
 /// path length when asked for.
 pub(super) struct Iteration {
     /// Light tracing's splats.
-    pub splats: PassSplats,
+    pub splats: Option<PassSplats>,
     /// The camera pass's tiles.
     pub tiles: Vec<FilmTile>,
     /// Every pixel's camera-side estimate by path length (`record`).
@@ -47,7 +47,7 @@ impl VcmIntegrator {
         let time = self.time(ctx, pass);
         let mut light = self.light_pass(ctx, pass, &lambda, time, &f, Some(lt))?;
         self.stored.store(light.len() as u64, Ordering::Relaxed);
-        let splats = std::mem::replace(&mut light.splats, PassSplats::new(ctx.film, 1));
+        let splats = light.splats.take();
         if t.light_only {
             light.recycle(&self.pools.chunks);
             return Some(Iteration {

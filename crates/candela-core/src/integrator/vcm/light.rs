@@ -142,8 +142,9 @@ pub(super) struct PathChunk {
 /// through a `Pool`).
 pub struct LightPaths {
     chunks: Vec<PathChunk>,
-    /// The light-tracing splats (already scaled to one path per pixel).
-    pub splats: PassSplats,
+    /// The light-tracing splats (already scaled to one path per pixel),
+    /// until the iteration takes them.
+    pub splats: Option<PassSplats>,
 }
 
 impl LightPaths {
@@ -263,7 +264,10 @@ impl VcmIntegrator {
             splats.add(ctx.film, done.iter().map(|(_, split)| split.as_slice()));
             chunks.extend(done.into_iter().map(|(c, _)| c));
         }
-        Some(LightPaths { chunks, splats })
+        Some(LightPaths {
+            chunks,
+            splats: Some(splats),
+        })
     }
 
     /// Walks light path `i`, storing its vertices in `out` and splatting its

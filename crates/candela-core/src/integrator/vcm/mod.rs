@@ -490,7 +490,9 @@ impl Integrator for VcmIntegrator {
         let Some(it) = self.iteration(ctx, pass, lt, record) else {
             return PassOutcome::Cancelled;
         };
-        it.splats.add_to(block);
+        if let Some(splats) = &it.splats {
+            splats.add_to(block);
+        }
         for tile in &it.tiles {
             block.add_tile(tile);
         }
