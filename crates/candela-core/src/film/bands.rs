@@ -4,7 +4,7 @@
 //! Estimators that splat record their splats tile by tile. The film's rows
 //! are cut into bands of equal height, each a [`SplatBuffer`] of its own;
 //! every tile's records are sorted out by the bands whose rows the filter
-//! reaches from them ([`SplatBands::split`], on the thread that rendered the
+//! reaches from them ([`BandRows::split`], on the thread that rendered the
 //! tile), and every band replays its share of each tile in tile order (the
 //! bands in parallel). So every pixel receives its splats in tile order,
 //! whatever the thread count, and a pass's buffers together cover the film
@@ -15,7 +15,7 @@ use super::{Film, PassBlock};
 use crate::math::UVec2;
 use rayon::prelude::*;
 
-/// The rows of the bands: what [`SplatBands::split`] needs.
+/// The rows of the bands: what [`BandRows::split`] needs.
 #[derive(Clone, Copy, Debug)]
 pub struct BandRows {
     /// First row of the pixel bounds.

@@ -320,18 +320,6 @@ impl SplatBuffer {
         (((y - self.lo.y) * (self.hi.x - self.lo.x) + (x - self.lo.x)) as usize) * self.stride
     }
 
-    /// Sets every sum to zero, as a new buffer over the same pixels (for a
-    /// caller that reuses its buffers from pass to pass).
-    pub fn clear(&mut self) {
-        self.sums.fill(0.0);
-        self.dropped = 0;
-    }
-
-    /// True when the buffer covers the pixels `lo..hi`.
-    pub fn covers(&self, lo: UVec2, hi: UVec2) -> bool {
-        self.lo == lo && self.hi == hi
-    }
-
     /// Adds radiance-weighted importance `l` at raster position `p`, filtered
     /// over the pixels around it (ignored outside the pixel bounds;
     /// non-finite values are dropped and counted).

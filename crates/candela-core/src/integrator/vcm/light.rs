@@ -182,9 +182,9 @@ impl LightPaths {
     }
 }
 
-/// Buffers kept from one iteration to the next (vertex chunks, splat
-/// buffers), so a pass does not allocate (and fault in) its storage anew;
-/// the image never depends on it.
+/// Buffers kept from one iteration to the next (the vertex chunks), so a
+/// pass does not allocate (and fault in) its storage anew; the image never
+/// depends on it.
 pub(super) struct Pool<T>(Mutex<Vec<T>>);
 
 impl<T> Default for Pool<T> {
