@@ -23,7 +23,7 @@
 
 use super::{PassOutcome, PixelEstimator, RenderContext};
 use crate::camera::CameraSample;
-use crate::film::{BandRows, FilmTile, PassBlock, PassSplats, SplatBuffer, SplatRecord};
+use crate::film::{FilmTile, PassBlock, PassSplats, SplatBuffer, SplatRecord};
 use crate::math::{UVec2, Vec2};
 use crate::sampler::Sampler;
 use crate::spectrum::SampledWavelengths;
@@ -42,40 +42,40 @@ pub fn render_pixels(
     block: &mut PassBlock,
 ) -> PassOutcome {
     let tiles = tiles(ctx.film.pixel_bounds());
-    // Rendered a batch at a time, so the recorded splats of a batch are all
-    // that is held: 512 tiles of 256 pixels, 56 bytes a splat, 7.3 MB per
-    // splat per pixel sample (BDPT makes one per light vertex that sees the
-    // lens). A batch is enough tiles that its end idles a thread for at most
-    // one tile of 256 per thread.
-    const BATCH: usize = 512;
-    let mut splats = PassSplats::new(ctx.film, BANDS);
-    for batch in tiles.chunks(BATCH) {
-        let Some(done) = render_batch(est, ctx, pass, batch, splats.rows()) else {
-            return PassOutcome::Cancelled;
-        };
-        for (tile, _) in &done {
-            block.add_tile(tile);
-        }
-        splats.add(ctx.film, done.iter().map(|(_, split)| split.as_slice()));
-    }
+    // A batch of 512 tiles of 256 pixels holds 7.3 MB of records per splat
+    // per pixel sample (BDPT makes one per light vertex that sees the lens),
+    // and its end idles a thread for at most one tile of 256 per thread.
+    const BATCH: u64 = 512;
+    let task = |i: u64, rec: &mut SplatBuffer| {
+        let (lo, hi) = tiles[i as usize];
+        let tile = render_tile(est, ctx, pass, lo, hi, rec);
+        ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
+        tile
+    };
+    let add_tiles = |done: Vec<FilmTile>| done.iter().for_each(|t| block.add_tile(t));
+    let Some(splats) = splat_tasks(ctx, tiles.len() as u64, BATCH, task, add_tiles) else {
+        return PassOutcome::Cancelled;
+    };
     splats.add_to(block);
     PassOutcome::Done
 }
 
-/// Runs tasks `0..n_tasks` in parallel, `task(i, recorder)` recording its
-/// splats, and adds the splats to `block` in task order (by bands, so the
-/// sums do not depend on the thread count); tasks run [`BATCH_TASKS`] at a
-/// time, so only a batch's records are held.
-pub fn splat_tasks(
+/// Runs tasks `0..n_tasks` in parallel, `batch` at a time (only a batch's
+/// recorded splats are held), `task(i, recorder)` recording its splats;
+/// hands each batch's results, in task order, to `batch_done`, and returns
+/// the splats summed by bands in task order (so the sums do not depend on
+/// the thread count), or `None` if the render was cancelled.
+pub fn splat_tasks<T: Send>(
     ctx: &RenderContext<'_>,
-    block: &mut PassBlock,
     n_tasks: u64,
-    task: impl Fn(u64, &mut SplatBuffer) + Sync,
-) -> PassOutcome {
+    batch: u64,
+    task: impl Fn(u64, &mut SplatBuffer) -> T + Sync,
+    mut batch_done: impl FnMut(Vec<T>),
+) -> Option<PassSplats> {
     let mut splats = PassSplats::new(ctx.film, BANDS);
-    for first in (0..n_tasks).step_by(BATCH_TASKS as usize) {
+    for first in (0..n_tasks).step_by(batch.max(1) as usize) {
         let rows = splats.rows();
-        let done: Option<Vec<Vec<Vec<SplatRecord>>>> = (first..(first + BATCH_TASKS).min(n_tasks))
+        let done: Option<Vec<(T, Vec<Vec<SplatRecord>>)>> = (first..(first + batch).min(n_tasks))
             .into_par_iter()
             .map_init(
                 || SplatBuffer::recording(ctx.film),
@@ -83,47 +83,16 @@ pub fn splat_tasks(
                     if ctx.cancelled() {
                         return None;
                     }
-                    task(i, rec);
-                    Some(rows.split(&rec.take_records()))
+                    let out = task(i, rec);
+                    Some((out, rows.split(&rec.take_records())))
                 },
             )
             .collect();
-        let Some(done) = done else {
-            return PassOutcome::Cancelled;
-        };
-        splats.add(ctx.film, done.iter().map(|split| split.as_slice()));
+        let (outs, split): (Vec<T>, Vec<_>) = done?.into_iter().unzip();
+        splats.add(ctx.film, split.iter().map(Vec::as_slice));
+        batch_done(outs);
     }
-    splats.add_to(block);
-    PassOutcome::Done
-}
-
-/// Tasks of [`splat_tasks`] per batch.
-pub const BATCH_TASKS: u64 = 128;
-
-/// The tiles of `batch`, each a task of its own, with the splats each
-/// recorded split by the bands of `rows`, in the batch's order whatever
-/// thread rendered them; `None` if the render was cancelled.
-fn render_batch(
-    est: &dyn PixelEstimator,
-    ctx: &RenderContext<'_>,
-    pass: u64,
-    batch: &[(UVec2, UVec2)],
-    rows: &BandRows,
-) -> Option<Vec<(FilmTile, Vec<Vec<SplatRecord>>)>> {
-    batch
-        .par_iter()
-        .map_init(
-            || SplatBuffer::recording(ctx.film),
-            |rec, &(lo, hi)| {
-                if ctx.cancelled() {
-                    return None;
-                }
-                let tile = render_tile(est, ctx, pass, lo, hi, rec);
-                ctx.advance(u64::from((hi.x - lo.x) * (hi.y - lo.y)));
-                Some((tile, rows.split(&rec.take_records())))
-            },
-        )
-        .collect()
+    Some(splats)
 }
 
 /// Runs `f` on every tile of the film in parallel; the results come back in

@@ -33,6 +33,9 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 /// thread for at most one task), their splats recorded (56 bytes each) and
 /// summed in task order ([`driver::splat_tasks`]).
 const PATHS_PER_CHUNK: u64 = 1 << 10;
+/// Chunks per batch: 128 chunks' records (about 22 MB at three splats a
+/// path) are all that is held.
+const BATCH_CHUNKS: u64 = 128;
 
 /// Parameters of `Integrator "lightpath"`.
 #[derive(Clone, Debug)]
@@ -75,13 +78,21 @@ impl Integrator for LightTracer {
     ) -> PassOutcome {
         let n = paths_per_pass(ctx);
         let first = pass * n;
-        driver::splat_tasks(ctx, block, n.div_ceil(PATHS_PER_CHUNK), |c, rec| {
+        let task = |c: u64, rec: &mut SplatBuffer| {
             let end = ((c + 1) * PATHS_PER_CHUNK).min(n);
             for i in c * PATHS_PER_CHUNK..end {
                 self.trace_path(ctx, first + i, rec);
             }
             ctx.advance(end - c * PATHS_PER_CHUNK);
-        })
+        };
+        let n_tasks = n.div_ceil(PATHS_PER_CHUNK);
+        match driver::splat_tasks(ctx, n_tasks, BATCH_CHUNKS, task, |_| ()) {
+            Some(splats) => {
+                splats.add_to(block);
+                PassOutcome::Done
+            }
+            None => PassOutcome::Cancelled,
+        }
     }
 }
 

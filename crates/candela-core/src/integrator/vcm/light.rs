@@ -23,8 +23,8 @@ use super::mis::{thin, weight, Deferred, DirectMerges, Factors, Partial};
 use super::variance::LtWeights;
 use super::{Techniques, VcmIntegrator};
 use crate::bsdf::{Bsdf, LocalPair, TransportMode};
-use crate::film::{PassSplats, SplatBuffer, SplatRecord};
-use crate::integrator::driver::{BANDS, BATCH_TASKS};
+use crate::film::{PassSplats, SplatBuffer};
+use crate::integrator::driver::splat_tasks;
 use crate::integrator::nee::{nee_area_density, nee_context};
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
@@ -37,7 +37,6 @@ use crate::math::{Ray, Vec3};
 use crate::sampling::{hash_u64s, PathRng, StreamRng};
 use crate::spatial::HasPosition;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use rayon::prelude::*;
 use std::sync::Mutex;
 
 /// A stored light-subpath vertex: what a connection reads of it (a
@@ -125,8 +124,10 @@ impl PrevVertex {
 }
 
 /// Light paths per chunk: the unit of parallel work of the light pass (a
-/// task, run [`BATCH_TASKS`] at a time) and of storage.
+/// task, run [`BATCH_CHUNKS`] at a time) and of storage.
 pub(super) const CHUNK: usize = 1024;
+/// Chunks per batch of the light pass (only a batch's splat records are held).
+const BATCH_CHUNKS: u64 = 128;
 
 /// The stored vertices of [`CHUNK`] consecutive light paths.
 #[derive(Default)]
@@ -234,36 +235,21 @@ impl VcmIntegrator {
         let n = self.light_paths(ctx);
         let chunk = CHUNK as u64;
         let n_chunks = n.div_ceil(chunk);
-        let mut splats = PassSplats::new(ctx.film, BANDS);
+        let task = |c: u64, rec: &mut SplatBuffer| {
+            let mut out = self.pools.chunks.chunk();
+            let end = ((c + 1) * chunk).min(n);
+            for i in c * chunk..end {
+                let buf = lt.map(|lt| (&mut *rec, lt));
+                self.trace_light(ctx, pass, i, lambda, time, f, &mut out.vertices, buf);
+                out.ends.push(out.vertices.len() as u32);
+            }
+            ctx.advance(end - c * chunk);
+            out
+        };
         let mut chunks = Vec::with_capacity(n_chunks as usize);
-        for first in (0..n_chunks).step_by(BATCH_TASKS as usize) {
-            let rows = splats.rows();
-            let done: Option<Vec<(PathChunk, Vec<Vec<SplatRecord>>)>> = (first
-                ..(first + BATCH_TASKS).min(n_chunks))
-                .into_par_iter()
-                .map_init(
-                    || lt.is_some().then(|| SplatBuffer::recording(ctx.film)),
-                    |rec, c| {
-                        if ctx.cancelled() {
-                            return None;
-                        }
-                        let mut out = self.pools.chunks.chunk();
-                        let end = ((c + 1) * chunk).min(n);
-                        for i in c * chunk..end {
-                            let buf = rec.as_mut().zip(lt);
-                            self.trace_light(ctx, pass, i, lambda, time, f, &mut out.vertices, buf);
-                            out.ends.push(out.vertices.len() as u32);
-                        }
-                        ctx.advance(end - c * chunk);
-                        let records = rec.as_mut().map(|r| r.take_records()).unwrap_or_default();
-                        Some((out, rows.split(&records)))
-                    },
-                )
-                .collect();
-            let done = done?;
-            splats.add(ctx.film, done.iter().map(|(_, split)| split.as_slice()));
-            chunks.extend(done.into_iter().map(|(c, _)| c));
-        }
+        let splats = splat_tasks(ctx, n_chunks, BATCH_CHUNKS, task, |done| {
+            chunks.extend(done)
+        })?;
         Some(LightPaths {
             chunks,
             splats: Some(splats),
