@@ -387,44 +387,46 @@ pub fn sampler(
             spp,
             seed,
             resolution,
-            halton_randomize(&ck)?,
+            randomization(
+                &ck,
+                "Halton",
+                "permutedigits",
+                HaltonRandomize::from_name,
+                HaltonRandomize::NAMES,
+            )?,
         ))),
         SamplerKind::ZSobol => Ok(Sampler::ZSobol(ZSobolSampler::new(
             spp,
             seed,
             resolution,
-            zsobol_randomize(&ck)?,
+            randomization(
+                &ck,
+                "ZSobol",
+                "fastowen",
+                ZSobolRandomize::from_name,
+                ZSobolRandomize::NAMES,
+            )?,
         ))),
         _ => Ok(Sampler::new(kind, spp, seed)),
     }
 }
 
-/// `Sampler "zsobol"`'s `"string randomization"` (pbrt-v4's names and
-/// default, `fastowen`).
-fn zsobol_randomize(ck: &Check<'_>) -> Result<ZSobolRandomize, BuildError> {
-    let name = ck.params.get_string("randomization", "fastowen")?;
-    ZSobolRandomize::from_name(&name).ok_or_else(|| {
+/// A sampler's `"string randomization"` parsed by `from_name` (pbrt-v4's
+/// names and defaults: `permutedigits` for Halton, which refuses
+/// `fastowen` as pbrt-v4 does, `fastowen` for ZSobol); an error naming the
+/// parameter and the supported `names` otherwise.
+fn randomization<T>(
+    ck: &Check<'_>,
+    sampler: &str,
+    default: &str,
+    from_name: fn(&str) -> Option<T>,
+    names: &str,
+) -> Result<T, BuildError> {
+    let name = ck.params.get_string("randomization", default)?;
+    from_name(&name).ok_or_else(|| {
         ck.error(
             "randomization",
-            format!(
-                "\"{name}\" is not supported by the ZSobol sampler (supported: {})",
-                ZSobolRandomize::NAMES
-            ),
-        )
-    })
-}
-
-/// `Sampler "halton"`'s `"string randomization"` (pbrt-v4's names;
-/// `fastowen`, which pbrt-v4 refuses for Halton too, is an error).
-fn halton_randomize(ck: &Check<'_>) -> Result<HaltonRandomize, BuildError> {
-    let name = ck.params.get_string("randomization", "permutedigits")?;
-    HaltonRandomize::from_name(&name).ok_or_else(|| {
-        ck.error(
-            "randomization",
-            format!(
-                "\"{name}\" is not supported by the Halton sampler (supported: {})",
-                HaltonRandomize::NAMES
-            ),
+            format!("\"{name}\" is not supported by the {sampler} sampler (supported: {names})"),
         )
     })
 }

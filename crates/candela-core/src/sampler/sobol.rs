@@ -23,27 +23,31 @@
 use super::{dimension_hash, pixel_prefix, sample_from_bits};
 use crate::math::{UVec2, Vec2};
 
-/// Generator matrix columns of Sobol dimension 1 (column j for index bit j).
-const SOBOL_DIM1: [u32; 32] = sobol_dim1();
+/// Generator matrix columns of Sobol dimension 1 for 64 index bits, as the
+/// top 32 bits of 64-bit fractions: column j is m_j·2^(63−j) with
+/// m_j = 2m_{j−1} ⊕ m_{j−1}, m_0 = 1 (the polynomial x + 1). The first 32
+/// are the 32-bit matrix m_j·2^(31−j); the rest serve ZSobol's indices,
+/// which can pass 32 bits.
+const SOBOL_DIM1: [u32; 64] = sobol_dim1();
 
-/// Direction numbers of the polynomial x + 1: V_k = m_k·2^(32−k).
-const fn sobol_dim1() -> [u32; 32] {
-    let mut v = [0u32; 32];
-    let mut m: u64 = 1;
+const fn sobol_dim1() -> [u32; 64] {
+    let mut out = [0u32; 64];
+    let mut m: u128 = 1;
     let mut j = 0;
-    while j < 32 {
-        v[j] = (m << (31 - j)) as u32;
+    while j < 64 {
+        out[j] = ((m << (63 - j)) >> 32) as u32;
         m ^= m << 1;
         j += 1;
     }
-    v
+    out
 }
 
-/// Unscrambled 32-bit Sobol value of `index` in dimension 0 or 1.
+/// 32 fraction bits of Sobol dimension `dim` (0 or 1) at `index`.
 #[inline]
-fn sobol_bits(index: u32, dim: u32) -> u32 {
+pub(crate) fn sobol_bits(index: u64, dim: u32) -> u32 {
     if dim == 0 {
-        return index.reverse_bits();
+        // Bits of the index above 32 land below 2^−32.
+        return (index as u32).reverse_bits();
     }
     let mut v = 0;
     let mut a = index;
@@ -160,15 +164,21 @@ impl PaddedSobolSampler {
     /// One scrambled Sobol coordinate.
     pub fn get_1d(&mut self) -> f32 {
         let (h, index) = self.next(1);
-        sample_from_bits(owen_scramble(sobol_bits(index, 0), (h >> 32) as u32))
+        sample_from_bits(owen_scramble(
+            sobol_bits(u64::from(index), 0),
+            (h >> 32) as u32,
+        ))
     }
 
     /// Two scrambled Sobol coordinates (dimensions 0 and 1 of the pattern).
     pub fn get_2d(&mut self) -> Vec2 {
         let (h, index) = self.next(2);
         Vec2::new(
-            sample_from_bits(owen_scramble(sobol_bits(index, 0), h as u32)),
-            sample_from_bits(owen_scramble(sobol_bits(index, 1), (h >> 32) as u32)),
+            sample_from_bits(owen_scramble(sobol_bits(u64::from(index), 0), h as u32)),
+            sample_from_bits(owen_scramble(
+                sobol_bits(u64::from(index), 1),
+                (h >> 32) as u32,
+            )),
         )
     }
 }
@@ -185,6 +195,10 @@ mod tests {
         // First points of dimension 1: 0, 1/2, 3/4, 1/4.
         let v: Vec<u32> = (0..4).map(|i| sobol_bits(i, 1) >> 30).collect();
         assert_eq!(v, [0, 2, 3, 1]);
+        // Beyond 32 index bits a column keeps m_j's top bits: m_32 =
+        // 2^32 + 1 (binomial(32, k) is odd for k = 0, 32 only), the fraction
+        // m_32/2^33 = 1/2 + 2^−33, whose top 32 bits are 1/2.
+        assert_eq!(SOBOL_DIM1[32], 0x8000_0000);
     }
 
     #[test]

@@ -30,7 +30,7 @@
 //! fresh ZSobol point set.
 
 use super::sample_from_bits;
-use super::sobol::owen_scramble;
+use super::sobol::{owen_scramble, sobol_bits};
 use crate::math::{UVec2, Vec2};
 use crate::sampling::{hash_u64s, mix_bits};
 
@@ -114,43 +114,6 @@ const fn permutations4() -> [[u8; 4]; 24] {
         a += 1;
     }
     out
-}
-
-/// Generator matrix columns of Sobol dimension 1 for 64 index bits, as the
-/// top 32 bits of 64-bit fractions: column j is m_j·2^(63−j) with
-/// m_j = 2m_{j−1} ⊕ m_{j−1}, m_0 = 1 (the polynomial x + 1).
-const SOBOL_DIM1_64: [u32; 64] = sobol_dim1_64();
-
-const fn sobol_dim1_64() -> [u32; 64] {
-    let mut out = [0u32; 64];
-    let mut m: u128 = 1;
-    let mut j = 0;
-    while j < 64 {
-        out[j] = ((m << (63 - j)) >> 32) as u32;
-        m ^= m << 1;
-        j += 1;
-    }
-    out
-}
-
-/// 32 fraction bits of Sobol dimension `dim` (0 or 1) at a 64-bit index.
-#[inline]
-fn sobol_bits64(index: u64, dim: u32) -> u32 {
-    if dim == 0 {
-        // Bits of the index above 32 land below 2^−32.
-        return (index as u32).reverse_bits();
-    }
-    let mut v = 0;
-    let mut a = index;
-    let mut j = 0;
-    while a != 0 {
-        if a & 1 != 0 {
-            v ^= SOBOL_DIM1_64[j];
-        }
-        a >>= 1;
-        j += 1;
-    }
-    v
 }
 
 /// Interleaves the bits of x (even positions) and y (odd positions).
@@ -274,7 +237,7 @@ impl ZSobolSampler {
         self.dimension += 1;
         let index = self.sample_index(d);
         let (s, _) = self.scramble_seeds(d);
-        sample_from_bits(self.randomize.apply(sobol_bits64(index, 0), s))
+        sample_from_bits(self.randomize.apply(sobol_bits(index, 0), s))
     }
 
     /// Two coordinates (Sobol dimensions 0 and 1 of the dimension's point).
@@ -284,8 +247,8 @@ impl ZSobolSampler {
         let index = self.sample_index(d);
         let (s0, s1) = self.scramble_seeds(d);
         Vec2::new(
-            sample_from_bits(self.randomize.apply(sobol_bits64(index, 0), s0)),
-            sample_from_bits(self.randomize.apply(sobol_bits64(index, 1), s1)),
+            sample_from_bits(self.randomize.apply(sobol_bits(index, 0), s0)),
+            sample_from_bits(self.randomize.apply(sobol_bits(index, 1), s1)),
         )
     }
 }
@@ -295,7 +258,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tables_are_what_they_claim() {
+    fn permutations_and_morton_order() {
         // 24 distinct permutations of 0..4.
         let mut seen = std::collections::HashSet::new();
         for p in PERMUTATIONS {
@@ -304,16 +267,6 @@ mod tests {
             assert_eq!(s, [0, 1, 2, 3]);
             assert!(seen.insert(p));
         }
-        // The low 32 columns are the 32-bit generator of dimension 1 (m_k =
-        // 1, 3, 5, 15, ...), and the first points are 0, 1/2, 3/4, 1/4.
-        let m: Vec<u32> = (0..6).map(|j| SOBOL_DIM1_64[j] >> (31 - j)).collect();
-        assert_eq!(m, [1, 3, 5, 15, 17, 51]);
-        let v: Vec<u32> = (0..4).map(|i| sobol_bits64(i, 1) >> 30).collect();
-        assert_eq!(v, [0, 2, 3, 1]);
-        // Beyond 32 index bits a column keeps m_j's top bits: m_32 =
-        // 2^32 + 1 (binomial(32, k) is odd for k = 0, 32 only), the fraction
-        // m_32/2^33 = 1/2 + 2^−33, whose top 32 bits are 1/2.
-        assert_eq!(SOBOL_DIM1_64[32], 0x8000_0000);
         // x = 101, y = 1001: bits y3 x3 y2 x2 y1 x1 y0 x0 = 1 0 0 1 0 0 1 1.
         assert_eq!(morton2(0b101, 0b1001), 0b1001_0011);
     }
