@@ -304,9 +304,22 @@ pub(crate) fn pdf_from_hit(
     let Some(isect) = hit else {
         return PdfSolidAngle(0.0);
     };
-    let dist2 = ctx.p.distance_squared(isect.si.it.p);
-    let cos = isect.si.it.n.dot(wi.normalize()).abs();
-    let pdf = pdf_area_to_solid_angle(pdf_area(&isect.si.it), dist2, cos);
+    let it = &isect.si.it;
+    pdf_at_point(ctx, wi, it.p, it.n, pdf_area(it))
+}
+
+/// Solid-angle density at `ctx` of direction `wi`, which reaches the shape
+/// at `p` with normal `n` where the area density is `pdf_area` (0 when not
+/// finite).
+pub(crate) fn pdf_at_point(
+    ctx: &ShapeSampleContext,
+    wi: Vec3,
+    p: Vec3,
+    n: Vec3,
+    pdf_area: PdfArea,
+) -> PdfSolidAngle {
+    let cos = n.dot(wi.normalize()).abs();
+    let pdf = pdf_area_to_solid_angle(pdf_area, ctx.p.distance_squared(p), cos);
     if pdf.0.is_finite() {
         pdf
     } else {

@@ -16,7 +16,7 @@
 use super::{ShapeIntersection, ShapeSample, ShapeSampleContext, TriangleMesh};
 use crate::interaction::{Interaction, SurfaceInteraction};
 use crate::math::{gamma, Bounds3, Frame, Ray, Vec2, Vec3, Vec3A};
-use crate::sampling::{pdf_area_to_solid_angle, sample_uniform_triangle, PdfArea, PdfSolidAngle};
+use crate::sampling::{sample_uniform_triangle, PdfArea, PdfSolidAngle};
 use std::sync::Arc;
 
 /// Barycentrics and ray parameter of a ray–triangle hit.
@@ -420,13 +420,7 @@ impl TriangleSampler {
         let b = ti.b;
         let p =
             Vec3::from(b[0] * Vec3A::from(p0) + b[1] * Vec3A::from(p1) + b[2] * Vec3A::from(p2));
-        let cos = self.n.dot(wi.normalize()).abs();
-        let pdf = pdf_area_to_solid_angle(PdfArea(1.0 / self.area), ctx.p.distance_squared(p), cos);
-        if pdf.0.is_finite() {
-            pdf
-        } else {
-            PdfSolidAngle(0.0)
-        }
+        super::pdf_at_point(ctx, wi, p, self.n, self.pdf_area())
     }
 
     /// Area density of [`Self::sample_area`]: 1/A.
