@@ -8,9 +8,21 @@
 //! the Cornell box had mean blue 0.012 where 0.058 is right. Instead each
 //! pass has G *groups*, each with its own four wavelengths; photon `i` of
 //! the pass belongs to group `i mod G`, and a pixel belongs to the group
-//! hash(seed, pass, pixel index) mod G and gathers only its group's
+//! (hash(seed, pixel index) + pass) mod G and gathers only its group's
 //! photons. The colour noise then differs from pixel to pixel and averages
 //! out over the image instead of tinting it.
+//!
+//! **A pixel's groups over passes.** The hash places neighbouring pixels in
+//! unrelated groups; adding the pass makes every pixel visit the G groups
+//! in turn, once in any G consecutive passes, so its wavelengths over
+//! passes fill the strata below evenly (with u's low-discrepancy sequence,
+//! a rank-1 lattice) instead of drawing a stratum at random each pass.
+//! Measured with `sppm`, 32 iterations, relMSE between renders of seeds
+//! (1, 2), (3, 4), (5, 6) (twice the variance; bias cancels):
+//! caustic-glass at half size 0.0550/0.0516/0.0524 with a group hashed per
+//! pass against 0.0516/0.0483/0.0499 in turn (−6 %), the Cornell box at
+//! half size 0.00685/0.00399/0.00432 against 0.00678/0.00355/0.00386
+//! (−9 %; mean absolute error −16 %).
 //!
 //! **Stratification.** With a pass position u ∈ [0, 1) (stratified or
 //! low-discrepancy over passes, chosen by the integrator) and a hashed
@@ -22,8 +34,9 @@
 //! sampling, Pharr et al. 2023, §8.2]. The hero (j = 0, the wavelength a
 //! dispersive refraction keeps) lands in quarter k_g; k_g is hashed per
 //! (pass, group) so that the hero, like every other of the four, is
-//! uniformly distributed over [0, 1) when the group is picked at random —
-//! which is what a pixel's hashed group does.
+//! uniformly distributed over [0, 1) when the group is uniformly
+//! distributed — which a pixel's group is over seeds (its hash), as u is
+//! over seeds (its offset).
 //!
 //! **Unbiasedness.** A pixel in group g sees only the N_g photons of its
 //! group; each carries β·N/N_g, so its estimate is the usual one for N
@@ -93,8 +106,8 @@ impl PassWavelengths {
         if self.groups.len() == 1 {
             return 0;
         }
-        let h = hash_u64s(&[self.seed, self.pass, index, 0x5049_5847]);
-        (h % self.groups.len() as u64) as usize
+        let h = hash_u64s(&[self.seed, index, 0x5049_5847]);
+        ((h + self.pass) % self.groups.len() as u64) as usize
     }
 
     /// The group of photon `i` of the pass.
@@ -173,18 +186,33 @@ mod tests {
         }
     }
 
+    /// Pixels spread evenly over the groups in a pass, and each visits every
+    /// group once in any G consecutive passes (a group hashed per pass
+    /// would revisit one within G passes for most pixels, and fail).
     #[test]
-    fn pixel_groups_are_balanced_and_vary_by_pass() {
-        let a = PassWavelengths::new(3, 0, 0.1, 4);
-        let b = PassWavelengths::new(3, 1, 0.1, 4);
-        let mut count = [0usize; 4];
-        let mut differ = 0;
-        for i in 0..40_000u64 {
-            count[a.pixel_group(i)] += 1;
-            differ += usize::from(a.pixel_group(i) != b.pixel_group(i));
+    fn pixel_groups_are_balanced_and_each_pixel_visits_every_group_in_turn() {
+        for g in [3u32, 4] {
+            let passes: Vec<PassWavelengths> = (5..5 + u64::from(g))
+                .map(|p| PassWavelengths::new(3, p, 0.1, g))
+                .collect();
+            let n = 40_000u64;
+            let mut count = vec![0usize; g as usize];
+            for i in 0..n {
+                count[passes[0].pixel_group(i)] += 1;
+                let mut seen = vec![false; g as usize];
+                for pw in &passes {
+                    seen[pw.pixel_group(i)] = true;
+                }
+                assert!(seen.iter().all(|&s| s), "G = {g}, pixel {i}");
+            }
+            // Binomial(n, 1/G): 5σ.
+            let p = 1.0 / f64::from(g);
+            let five_sigma = 5.0 * (n as f64 * p * (1.0 - p)).sqrt();
+            let mean = n as f64 * p;
+            assert!(
+                count.iter().all(|&c| (c as f64 - mean).abs() < five_sigma),
+                "{count:?}"
+            );
         }
-        // Binomial(40000, 1/4): σ ≈ 87, so 5σ ≈ 433.
-        assert!(count.iter().all(|&c| c.abs_diff(10_000) < 433), "{count:?}");
-        assert!(differ > 25_000, "groups change with the pass: {differ}");
     }
 }
