@@ -20,9 +20,10 @@
 //! Measured with `sppm`, 32 iterations, relMSE between renders of seeds
 //! (1, 2), (3, 4), (5, 6) (twice the variance; bias cancels):
 //! caustic-glass at half size 0.0550/0.0516/0.0524 with a group hashed per
-//! pass against 0.0516/0.0483/0.0499 in turn (−6 %), the Cornell box at
-//! half size 0.00685/0.00399/0.00432 against 0.00678/0.00355/0.00386
-//! (−9 %; mean absolute error −16 %).
+//! pass against 0.0516/0.0483/0.0499 in turn (−5 to −6 %; mean absolute
+//! error −5 %), the Cornell box at half size 0.00685/0.00399/0.00432
+//! against 0.00678/0.00355/0.00386 (−1 to −11 %; mean absolute error
+//! 0.0109/0.0108/0.0112 against 0.0092/0.0087/0.0094, −15 to −20 %).
 //!
 //! **Stratification.** With a pass position u ∈ [0, 1) (stratified or
 //! low-discrepancy over passes, chosen by the integrator) and a hashed
