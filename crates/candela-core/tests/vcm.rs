@@ -223,7 +223,7 @@ fn pool_small_at(integrator: &str, depth: u32) -> String {
             "\"integer xresolution\" [64] \"integer yresolution\" [48]",
         )
         .replace(
-            "Integrator \"sppm\" \"integer maxdepth\" [8]",
+            "Integrator \"sppm\" \"integer maxdepth\" [40]",
             &format!("Integrator {integrator} \"integer maxdepth\" [{depth}]"),
         );
     assert!(
