@@ -66,10 +66,11 @@ CLOSING = re.compile(
     r"render ([0-9.]+) s")
 
 
-def scaled_scene(path, scale):
-    """The scene at `scale` × its film resolution, as a temporary file
-    beside it (so relative includes resolve), or the scene itself."""
-    if scale == 1.0:
+def scaled_scene(path, scale, maxdepth=None):
+    """The scene at `scale` × its film resolution and, when given, with its
+    Integrator's `maxdepth` set to `maxdepth`, as a temporary file beside it
+    (so relative includes resolve), or the scene itself."""
+    if scale == 1.0 and maxdepth is None:
         return path, False
     text = open(path).read()
 
@@ -78,6 +79,12 @@ def scaled_scene(path, scale):
     text, n = re.subn(r'"integer ([xy])resolution"\s*\[\s*(\d+)\s*\]', res, text)
     if n != 2:
         sys.exit(f"{path}: expected x and y resolutions to scale, found {n}")
+    if maxdepth is not None:
+        text = re.sub(r'\s*"integer maxdepth"\s*\[\s*\d+\s*\]', "", text)
+        text, n = re.subn(r'^(Integrator\s+"[^"]+")', rf'\1 "integer maxdepth" [{maxdepth}]', text,
+                          flags=re.M)
+        if n != 1:
+            sys.exit(f"{path}: expected one Integrator line to set maxdepth, found {n}")
     f = tempfile.NamedTemporaryFile("w", suffix=".pbrt", dir=os.path.dirname(path), delete=False)
     f.write(text)
     f.close()
@@ -140,7 +147,7 @@ def bench_scene(name, a, outdir, rows, vertex_info):
     each repetition walks the time limits and, at each, every integrator in
     turn, so a slow spell of the machine falls on neighbours alike; rows
     get the median of each figure over the repetitions."""
-    scene, temporary = scaled_scene(SCENES[name], a.scale)
+    scene, temporary = scaled_scene(SCENES[name], a.scale, a.maxdepth)
     try:
         ref = reference(name, scene, a, outdir)
         pixels = film_pixels(scene)
@@ -270,6 +277,10 @@ def main():
     ap.add_argument("--steps", type=int, default=6, help="time limits t0 * 2^k, k < steps")
     ap.add_argument("--reps", type=int, default=1,
                     help="repetitions, interleaved; the table holds medians (the machine's speed drifts)")
+    ap.add_argument("--maxdepth", type=int, default=None,
+                    help="set every scene's Integrator maxdepth (sppm and ppm bound each subpath, "
+                         "vcm, bdpt and path the whole path: at a small depth they render different "
+                         "images, so compare them where the image has stopped changing)")
     ap.add_argument("--ref-seconds", type=float, default=3600.0)
     ap.add_argument("--ref-integrator", default="vcm")
     ap.add_argument("--ref", action="append", default=[], metavar="SCENE=EXR",
