@@ -88,8 +88,8 @@ fn multiplicative_inverse(a: i64, n: i64) -> u64 {
 
 /// Element `i` of a hashed permutation of `0..l` chosen by `p` [Kensler
 /// 2013, "Correlated Multi-Jittered Sampling", §3, `permute`], for the
-/// Owen scramble's per-digit permutations. candela's Sobol index
-/// permutation (`sobol::permute_index`) is not used in this module: its
+/// Owen scramble's per-digit permutations. The hashed index permutation
+/// padded Sobol used until stop 38 was not used in this module: its
 /// few rounds reach a small family of the permutations of a handful of
 /// elements, and as the digit tables it gave killeroo-simple (16 spp,
 /// relMSE without the worst 0.1 % of pixels, seeds 0–2) 0.0044, 0.0058,
