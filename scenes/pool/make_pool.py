@@ -137,7 +137,7 @@ Sampler "independent" "integer pixelsamples" [64]
 # bound the camera and the photon path each, vcm, path and bdpt the whole
 # path, and light trapped under the waves by total internal reflection makes
 # long paths: at depth 8 vcm's image was 1.2-2.3 % darker than sppm's (300-s
-# renders; blocks of the pool up to 6 %), at 40 the two agree to 0.8 %.
+# renders; blocks of the pool up to 6 %), at 40 the two agree to 0.9 %.
 Integrator "sppm" "integer maxdepth" [40]
 
 WorldBegin
