@@ -59,17 +59,38 @@ pub(crate) fn sobol_bits(index: u64, dim: u32) -> u32 {
         // Bits of the index above 32 land below 2^−32.
         return (index as u32).reverse_bits();
     }
+    // A byte of the index at a time: padded Sobol's scrambled indices and
+    // ZSobol's Morton-prefixed ones have set bits all the way up, where a
+    // column per set bit cost 6 % of a path-traced render's instructions.
     let mut v = 0;
     let mut a = index;
-    let mut j = 0;
+    let mut k = 0;
     while a != 0 {
-        if a & 1 != 0 {
-            v ^= SOBOL_DIM1[j];
-        }
-        a >>= 1;
-        j += 1;
+        v ^= SOBOL_DIM1_BYTES[k][(a & 0xff) as usize];
+        a >>= 8;
+        k += 1;
     }
     v
+}
+
+/// [`SOBOL_DIM1`] by bytes: entry [k][b] is the XOR of the columns 8k + j
+/// for every bit j set in b.
+static SOBOL_DIM1_BYTES: [[u32; 256]; 8] = sobol_dim1_bytes();
+
+const fn sobol_dim1_bytes() -> [[u32; 256]; 8] {
+    let mut out = [[0u32; 256]; 8];
+    let mut k = 0;
+    while k < 8 {
+        let mut b = 1;
+        while b < 256 {
+            // b's lowest set bit's column XOR the entry for b without it.
+            let j = (b as u32).trailing_zeros() as usize;
+            out[k][b] = SOBOL_DIM1[8 * k + j] ^ out[k][b & (b - 1)];
+            b += 1;
+        }
+        k += 1;
+    }
+    out
 }
 
 /// Owen-style nested scramble by a hash whose low bits only affect higher
@@ -179,6 +200,19 @@ mod tests {
         // 2^32 + 1 (binomial(32, k) is odd for k = 0, 32 only), the fraction
         // m_32/2^33 = 1/2 + 2^−33, whose top 32 bits are 1/2.
         assert_eq!(SOBOL_DIM1[32], 0x8000_0000);
+        // The byte tables give the column-by-column sum, low and high bits.
+        let mut rng = crate::sampling::Pcg32::new(5, 7);
+        for i in (0..2000u64)
+            .chain((0..2000).map(|_| u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32())))
+        {
+            let mut want = 0;
+            for (j, column) in SOBOL_DIM1.iter().enumerate() {
+                if i >> j & 1 != 0 {
+                    want ^= column;
+                }
+            }
+            assert_eq!(sobol_bits(i, 1), want, "index {i:#x}");
+        }
     }
 
     /// The first 2^k samples of a request use an aligned block of 2^k Sobol
