@@ -249,7 +249,7 @@ impl HaltonSampler {
                 reversed
             }
         };
-        to_unit(reversed, base.scale)
+        to_unit(reversed, base.inv_scale)
     }
 }
 
