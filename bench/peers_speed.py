@@ -33,9 +33,10 @@ medians are printed, so load from other processes skews both sides alike):
   its 1024-spp BDPT render beside the scene), so the comparison measures the
   estimators and not the models: candela's coated floor is ~7.5 % darker than
   pbrt-v4's by design (it matches pbrt-v4's layered random walk, which
-  pbrt-v4's stochastic f() overestimates). pbrt-v4 has no time limit, so its
-  iteration count is calibrated to the same time. Both render --reps times
-  with seeds 1, 2, ... (pbrt-v4's --seed), and the medians are compared.
+  pbrt-v4's stochastic f() overestimates). pbrt-v4 has no time limit: its
+  iteration count is calibrated to about --seconds, and in every rep candela
+  is then given the wall time pbrt-v4 took (both printed). Both render --reps
+  times with seeds 1, 2, ... (pbrt-v4's --seed), and the medians are compared.
   Target: candela's relMSE <= 0.7 x pbrt-v4's. Lines "without the worst 0.1 %
   of pixels" give both (`candela diff`): candela's photons carry the adjoint shading-normal
   correction [Veach 1997, eq. 5.19] that pbrt-v4 leaves out, which keeps them
@@ -178,16 +179,25 @@ def case_sppm(pbrt, seconds, ref_spp, reps):
               for label in ("image", "caustic") for trim in (False, True)}
     try:
         c_out, p_out = os.path.join(OUT, "sppm-candela.exr"), os.path.join(OUT, "sppm-pbrt.exr")
-        # pbrt-v4 has no time limit: time a short run, then give it the
-        # iterations that fill `seconds` (calibrated once, used for every rep).
-        t4 = timed(pbrt_cmd(pbrt, s, 4, 2, p_out))
+        # pbrt-v4 has no time limit: time two short runs and give it the
+        # iterations that fill about `seconds` (its iterations slow down as
+        # they go, so this is only a start); then candela gets the wall time
+        # pbrt-v4 actually took in that rep: its --time-limit is that time
+        # less candela's fixed cost (parse, build, write) and half an
+        # iteration (it stops after the pass that crosses the limit).
         t8 = timed(pbrt_cmd(pbrt, s, 8, 2, p_out))
-        per = max((t8 - t4) / 4, 1e-3)
-        n = max(1, round((seconds - (t4 - 4 * per)) / per))
+        t16 = timed(pbrt_cmd(pbrt, s, 16, 2, p_out))
+        per = max((t16 - t8) / 8, 1e-3)
+        n = max(1, round((seconds - (t8 - 8 * per)) / per))
+        c1 = timed(candela_cmd(s, 1, 2, c_out))
+        c5 = timed(candela_cmd(s, 5, 2, c_out))
+        c_per = (c5 - c1) / 4
+        c_fixed = max(c1 - c_per, 0.0)
         for rep in range(reps):
             seed = str(rep + 1)
-            tc = timed(candela_cmd(s, 10**6, 2, c_out, ["--time-limit", str(seconds), "--seed", seed]))
             tp = timed(pbrt_cmd(pbrt, s, n, 2, p_out, ["--seed", seed]))
+            limit = max(tp - c_fixed - c_per / 2, 1.0)
+            tc = timed(candela_cmd(s, 10**6, 2, c_out, ["--time-limit", f"{limit:.2f}", "--seed", seed]))
             print(f"sppm caustic-glass seed {seed}: candela {tc:.1f} s, pbrt-v4 {tp:.1f} s ({n} iterations)")
             for region, label in ((None, "image"), (CAUSTIC_REGION, "caustic")):
                 ec, ep = rel_mse(c_out, ref, region), rel_mse(p_out, CAUSTIC_REF_PBRT, region)
