@@ -240,6 +240,80 @@ impl DielectricBxdf {
         }
     }
 
+    /// [`Self::sample_f`] for the random walks inside a layered BSDF, where a
+    /// sample's f and density need not equal [`Self::f`] and [`Self::pdf`] to
+    /// the last bit (nothing joins a walk's vertices by MIS across
+    /// techniques; its own exits weigh densities that already differ by
+    /// sampling): a rough interface's f and density come from the sampled
+    /// ωm and its Fresnel terms, as pbrt-v4's `DielectricBxDF::Sample_f`
+    /// computes them, not again from the generalised half vector in f64.
+    /// The same values up to round-off, for about a third fewer instructions
+    /// than [`Self::sample_f`]; coated surfaces' walks sample the interface
+    /// several times per scattering.
+    pub fn sample_f_walk(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        allowed: SampleFlags,
+    ) -> Option<BsdfSample> {
+        if self.is_specular() {
+            return self.sample_specular(wo, uc, mode, allowed);
+        }
+        if wo.z == 0.0 {
+            return None;
+        }
+        let wm = self.distrib.sample_wm(wo, u);
+        let dot_o = wo.dot(wm);
+        let (r, t) = (
+            fr_dielectric(dot_o, self.eta),
+            ft_dielectric(dot_o, self.eta),
+        );
+        let (pr, pt) = lobe_probs(r, t, allowed);
+        if pr == 0.0 && pt == 0.0 {
+            return None;
+        }
+        let d = self.distrib.d(wm);
+        let lambda_o = self.distrib.lambda(wo);
+        let cos_o = local::cos_theta(wo);
+        // Visible-normal density D_ωo(ωm) [Heitz 2018, eq. 1].
+        let d_vis = d * dot_o.abs() / ((1.0 + lambda_o) * cos_o.abs());
+        let (wi, flags, etap, f, pdf) = if uc < pr / (pr + pt) {
+            let wi = local::reflect(wo, wm);
+            if !local::same_hemisphere(wo, wi) {
+                return None;
+            }
+            let g = 1.0 / (1.0 + lambda_o + self.distrib.lambda(wi));
+            let f = d * g * r / (4.0 * local::cos_theta(wi) * cos_o).abs();
+            let pdf = d_vis / (4.0 * dot_o.abs()) * pr / (pr + pt);
+            (wi, BxdfFlags::GLOSSY_REFLECTION, 1.0, f, pdf)
+        } else {
+            let (wi, etap) = refract(wo, wm, self.eta)?;
+            if local::same_hemisphere(wo, wi) || wi.z == 0.0 {
+                return None;
+            }
+            let dot_i = wi.dot(wm);
+            let denom = sqr(dot_i + dot_o / etap);
+            let g = 1.0 / (1.0 + lambda_o + self.distrib.lambda(wi));
+            // [Walter et al. 2007, eqs. 17 and 21]
+            let mut f = d * g * t * (dot_i * dot_o / (local::cos_theta(wi) * cos_o * denom)).abs();
+            if mode == TransportMode::Radiance {
+                f /= sqr(etap);
+            }
+            let pdf = d_vis * dot_i.abs() / denom * pt / (pr + pt);
+            (wi, BxdfFlags::GLOSSY_TRANSMISSION, etap, f, pdf)
+        };
+        (pdf > 0.0 && f.is_finite()).then(|| BsdfSample {
+            f: SampledSpectrum::splat(f),
+            wi,
+            pdf: PdfSolidAngle(pdf),
+            flags,
+            eta: etap,
+            pdf_is_proportional: false,
+        })
+    }
+
     /// Delta reflection or refraction chosen by Fresnel [pbrt-v4 §9.5].
     fn sample_specular(
         &self,

@@ -82,6 +82,17 @@ pub trait LayerBxdf: Copy + std::fmt::Debug {
         mode: TransportMode,
         allowed: SampleFlags,
     ) -> Option<BsdfSample>;
+    /// [`LayerBxdf::sample_f`] for the walks, where the sample's f and density
+    /// may differ from [`LayerBxdf::f`] and [`LayerBxdf::pdf`] by round-off
+    /// ([`DielectricBxdf::sample_f_walk`]).
+    fn sample_f_walk(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        allowed: SampleFlags,
+    ) -> Option<BsdfSample>;
     /// Density of [`LayerBxdf::sample_f`].
     fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode, allowed: SampleFlags) -> PdfSolidAngle;
     /// Lobes present.
@@ -90,9 +101,10 @@ pub trait LayerBxdf: Copy + std::fmt::Debug {
     fn regularize(&mut self);
 }
 
-/// Forwards [`LayerBxdf`] to the inherent methods of each listed BxDF.
+/// Forwards [`LayerBxdf`] to the inherent methods of each listed BxDF, with
+/// the inherent method that samples inside a walk after the colon.
 macro_rules! layer_bxdf {
-    ($($t:ty),*) => {$(
+    ($($t:ty: $walk:ident),*) => {$(
         impl LayerBxdf for $t {
             #[inline]
             fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> SampledSpectrum {
@@ -110,6 +122,17 @@ macro_rules! layer_bxdf {
                 <$t>::sample_f(self, wo, uc, u, mode, allowed)
             }
             #[inline]
+            fn sample_f_walk(
+                &self,
+                wo: Vec3,
+                uc: f32,
+                u: Vec2,
+                mode: TransportMode,
+                allowed: SampleFlags,
+            ) -> Option<BsdfSample> {
+                <$t>::$walk(self, wo, uc, u, mode, allowed)
+            }
+            #[inline]
             fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode, allowed: SampleFlags) -> PdfSolidAngle {
                 <$t>::pdf(self, wo, wi, mode, allowed)
             }
@@ -125,7 +148,7 @@ macro_rules! layer_bxdf {
     )*};
 }
 
-layer_bxdf!(DielectricBxdf, DiffuseBxdf, ConductorBxdf);
+layer_bxdf!(DielectricBxdf: sample_f_walk, DiffuseBxdf: sample_f, ConductorBxdf: sample_f);
 
 /// The medium between the layers and the walk budget (pbrt-v4 names and defaults).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -200,7 +223,7 @@ fn sample_layer(
     allowed: SampleFlags,
 ) -> Option<BsdfSample> {
     let uc = rng.uniform_f32();
-    let bs = b.sample_f(wo, uc, u2(rng), mode, allowed)?;
+    let bs = b.sample_f_walk(wo, uc, u2(rng), mode, allowed)?;
     (!bs.f.is_black() && bs.pdf.0 > 0.0 && bs.wi.z != 0.0).then_some(bs)
 }
 
@@ -289,7 +312,7 @@ impl<B: LayerBxdf> LayeredBxdf<B> {
         }
         let flip = wo.z < 0.0;
         let wo = if flip { -wo } else { wo };
-        let first = self.top.sample_f(wo, uc, u, mode, SampleFlags::ALL)?;
+        let first = self.top.sample_f_walk(wo, uc, u, mode, SampleFlags::ALL)?;
         if first.f.is_black() || first.pdf.0 == 0.0 || first.wi.z == 0.0 {
             return None;
         }
