@@ -16,7 +16,7 @@
 //! lower half is squashed by (1 + cos θh)/2), lifted, and un-stretched
 //! [Heitz 2018, §4].
 
-use crate::math::{lerp, local, safe_sqrt, Vec2, Vec3, PI};
+use crate::math::{lerp, local, safe_sqrt, sqr, Vec2, Vec3, PI};
 use crate::sampling::sample_uniform_disk_polar;
 
 /// Anisotropic Trowbridge–Reitz distribution of microfacet normals.
@@ -73,32 +73,34 @@ impl TrowbridgeReitz {
     }
 
     /// Normal distribution D(ωm) [Walter et al. 2007, eq. 33].
+    ///
+    /// tan²θ (cos²φ/α_x² + sin²φ/α_y²) is written (x²/α_x² + y²/α_y²)/z²,
+    /// and likewise in [`Self::lambda`]: no sin θ, no division for cos φ and
+    /// sin φ (D and Λ are evaluated several times per rough scattering, and
+    /// many times in a coated surface's walk).
     #[inline]
     pub fn d(&self, wm: Vec3) -> f32 {
-        let tan2 = local::tan2_theta(wm);
-        if tan2.is_infinite() || tan2.is_nan() {
-            return 0.0;
-        }
-        let cos4 = local::cos2_theta(wm) * local::cos2_theta(wm);
+        let z2 = wm.z * wm.z;
+        let cos4 = z2 * z2;
         if cos4 < 1e-16 {
             return 0.0;
         }
-        let e = tan2
-            * (local::cos_phi(wm).powi(2) / (self.alpha_x * self.alpha_x)
-                + local::sin_phi(wm).powi(2) / (self.alpha_y * self.alpha_y));
-        1.0 / (PI * self.alpha_x * self.alpha_y * cos4 * (1.0 + e) * (1.0 + e))
-    }
-
-    /// Smith auxiliary function Λ(ω) [Heitz 2014, §5].
-    #[inline]
-    pub fn lambda(&self, w: Vec3) -> f32 {
-        let tan2 = local::tan2_theta(w);
-        if tan2.is_infinite() || tan2.is_nan() {
+        let e = (sqr(wm.x / self.alpha_x) + sqr(wm.y / self.alpha_y)) / z2;
+        if !e.is_finite() {
             return 0.0;
         }
-        let alpha2 =
-            (local::cos_phi(w) * self.alpha_x).powi(2) + (local::sin_phi(w) * self.alpha_y).powi(2);
-        ((1.0 + alpha2 * tan2).sqrt() - 1.0) / 2.0
+        1.0 / (PI * self.alpha_x * self.alpha_y * cos4 * sqr(1.0 + e))
+    }
+
+    /// Smith auxiliary function Λ(ω) [Heitz 2014, §5]; 0 where tan θ is
+    /// infinite (pbrt-v4's convention).
+    #[inline]
+    pub fn lambda(&self, w: Vec3) -> f32 {
+        let alpha2_tan2 = (sqr(self.alpha_x * w.x) + sqr(self.alpha_y * w.y)) / (w.z * w.z);
+        if !alpha2_tan2.is_finite() {
+            return 0.0;
+        }
+        ((1.0 + alpha2_tan2).sqrt() - 1.0) / 2.0
     }
 
     /// Masking G1(ω) = 1/(1 + Λ(ω)).
