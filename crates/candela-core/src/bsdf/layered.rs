@@ -73,16 +73,7 @@ use crate::spectrum::SampledSpectrum;
 pub trait LayerBxdf: Copy + std::fmt::Debug {
     /// f(wo, wi) in the local frame.
     fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> SampledSpectrum;
-    /// Samples wi given wo.
-    fn sample_f(
-        &self,
-        wo: Vec3,
-        uc: f32,
-        u: Vec2,
-        mode: TransportMode,
-        allowed: SampleFlags,
-    ) -> Option<BsdfSample>;
-    /// [`LayerBxdf::sample_f`] for the walks, where the sample's f and density
+    /// Samples wi given wo for the walks, where the sample's f and density
     /// may differ from [`LayerBxdf::f`] and [`LayerBxdf::pdf`] by round-off
     /// ([`DielectricBxdf::sample_f_walk`]).
     fn sample_f_walk(
@@ -93,7 +84,7 @@ pub trait LayerBxdf: Copy + std::fmt::Debug {
         mode: TransportMode,
         allowed: SampleFlags,
     ) -> Option<BsdfSample>;
-    /// Density of [`LayerBxdf::sample_f`].
+    /// Density of [`LayerBxdf::sample_f_walk`] (up to its round-off).
     fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode, allowed: SampleFlags) -> PdfSolidAngle;
     /// Lobes present.
     fn flags(&self) -> BxdfFlags;
@@ -109,17 +100,6 @@ macro_rules! layer_bxdf {
             #[inline]
             fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> SampledSpectrum {
                 <$t>::f(self, wo, wi, mode)
-            }
-            #[inline]
-            fn sample_f(
-                &self,
-                wo: Vec3,
-                uc: f32,
-                u: Vec2,
-                mode: TransportMode,
-                allowed: SampleFlags,
-            ) -> Option<BsdfSample> {
-                <$t>::sample_f(self, wo, uc, u, mode, allowed)
             }
             #[inline]
             fn sample_f_walk(
