@@ -7,6 +7,12 @@ speed targets of the speed issue, printed as ratios.
 pbrt-v4 is not on the package registries: build mmp/pbrt-v4 (with its
 submodules) from source yourself, outside this repository, and name the
 binary in $PBRT_V4; without it the pbrt-v4 columns are skipped with a message.
+pbrt-v4's default build is compiled for the host CPU (`-march=native`, its
+PBRT_BUILD_NATIVE_EXECUTABLE option) and candela's for generic x86-64 (its
+BVH kernel picks AVX2 at run time); on a host with AVX-512 that was worth
+1.27-1.31x to pbrt-v4. $PBRT_V4_GENERIC, if set, names a second pbrt-v4 built
+with -DPBRT_BUILD_NATIVE_EXECUTABLE=OFF: the path and bdpt cases then time it
+in the same alternation and print the ratio against it too.
 Mitsuba 3 (`scalar_spectral`) is imported if this Python has it (install it
 with `pip install mitsuba numpy`, e.g. in a virtual environment, and run this
 script with that environment's python); otherwise its case is skipped.
@@ -103,7 +109,7 @@ def ratio_line(label, a, b, target, cmp):
     print(f"{label:<44} {a:8.2f} s {b:8.2f} s   ratio {r:5.3f}  ({ok} target {target})")
 
 
-def case_path_bdpt(pbrt, reps, which):
+def case_path_bdpt(pbrt, generic, reps, which):
     if not pbrt:
         print(f"{which}: skipped, $PBRT_V4 is not set")
         return
@@ -113,15 +119,20 @@ def case_path_bdpt(pbrt, reps, which):
         if kind != which:
             continue
         s = variant(scene, integ, params)
+        runs = {
+            "candela": lambda: timed(candela_cmd(s, spp, 2, os.path.join(OUT, "c.exr"))),
+            "pbrt": lambda: timed(pbrt_cmd(pbrt, s, spp, 2, os.path.join(OUT, "p.exr"))),
+        }
+        if generic:
+            runs["generic"] = lambda: timed(pbrt_cmd(generic, s, spp, 2, os.path.join(OUT, "p.exr")))
         try:
-            t = alternate({
-                "candela": lambda: timed(candela_cmd(s, spp, 2, os.path.join(OUT, "c.exr"))),
-                "pbrt": lambda: timed(pbrt_cmd(pbrt, s, spp, 2, os.path.join(OUT, "p.exr"))),
-            }, reps)
+            t = alternate(runs, reps)
         finally:
             os.unlink(s)
         name = f"{integ} {os.path.basename(os.path.dirname(scene))} {spp} spp, 2 threads"
         ratio_line(f"{name}: candela / pbrt-v4", t["candela"], t["pbrt"], 0.5, float.__le__)
+        if generic:
+            ratio_line(f"{name}: candela / pbrt-v4 generic", t["candela"], t["generic"], 0.5, float.__le__)
 
 
 def case_mitsuba(reps):
@@ -239,13 +250,14 @@ def main():
     os.makedirs(OUT, exist_ok=True)
     subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "candela"], cwd=ROOT)
     pbrt = os.environ.get("PBRT_V4")
+    generic = os.environ.get("PBRT_V4_GENERIC")
     with open("/proc/loadavg") as f:
         print(f"load average at start: {f.read().split()[0]} on {os.cpu_count()} cores")
     cases = a.cases.split(",")
     if "path" in cases:
-        case_path_bdpt(pbrt, a.reps, "path")
+        case_path_bdpt(pbrt, generic, a.reps, "path")
     if "bdpt" in cases:
-        case_path_bdpt(pbrt, a.reps, "bdpt")
+        case_path_bdpt(pbrt, generic, a.reps, "bdpt")
     if "mitsuba" in cases:
         case_mitsuba(a.reps)
     if "sppm" in cases:
