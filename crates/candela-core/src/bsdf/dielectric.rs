@@ -74,6 +74,20 @@ fn lobe_probs(r: f32, t: f32, allowed: SampleFlags) -> (f32, f32) {
     (pr, pt)
 }
 
+/// A rough interface's sampled direction ([`DielectricBxdf::sample_rough_direction`]).
+struct RoughSample {
+    /// The visible normal.
+    wm: Vec3,
+    wi: Vec3,
+    flags: BxdfFlags,
+    /// Relative index across the interface (1 for reflection).
+    etap: f32,
+    /// Fresnel reflectance and transmittance at ωo·ωm.
+    fresnel: (f32, f32),
+    /// The lobes' selection weights from them.
+    probs: (f32, f32),
+}
+
 impl DielectricBxdf {
     /// New dielectric interface.
     pub fn new(eta: f32, distrib: TrowbridgeReitz) -> Self {
@@ -261,48 +275,33 @@ impl DielectricBxdf {
         if self.is_specular() {
             return self.sample_specular(wo, uc, mode, allowed);
         }
-        if wo.z == 0.0 {
-            return None;
-        }
-        let wm = self.distrib.sample_wm(wo, u);
+        let RoughSample {
+            wm,
+            wi,
+            flags,
+            etap,
+            fresnel: (r, t),
+            probs: (pr, pt),
+        } = self.sample_rough_direction(wo, uc, u, allowed)?;
         let dot_o = wo.dot(wm);
-        let (r, t) = (
-            fr_dielectric(dot_o, self.eta),
-            ft_dielectric(dot_o, self.eta),
-        );
-        let (pr, pt) = lobe_probs(r, t, allowed);
-        if pr == 0.0 && pt == 0.0 {
-            return None;
-        }
         let d = self.distrib.d(wm);
         let lambda_o = self.distrib.lambda(wo);
-        let cos_o = local::cos_theta(wo);
+        let g = 1.0 / (1.0 + lambda_o + self.distrib.lambda(wi));
+        let (cos_o, cos_i) = (local::cos_theta(wo), local::cos_theta(wi));
         // Visible-normal density D_ωo(ωm) [Heitz 2018, eq. 1].
         let d_vis = d * dot_o.abs() / ((1.0 + lambda_o) * cos_o.abs());
-        let (wi, flags, etap, f, pdf) = if uc < pr / (pr + pt) {
-            let wi = local::reflect(wo, wm);
-            if !local::same_hemisphere(wo, wi) {
-                return None;
-            }
-            let g = 1.0 / (1.0 + lambda_o + self.distrib.lambda(wi));
-            let f = d * g * r / (4.0 * local::cos_theta(wi) * cos_o).abs();
-            let pdf = d_vis / (4.0 * dot_o.abs()) * pr / (pr + pt);
-            (wi, BxdfFlags::GLOSSY_REFLECTION, 1.0, f, pdf)
+        let (f, pdf) = if flags.contains(BxdfFlags::REFLECTION) {
+            let f = d * g * r / (4.0 * cos_i * cos_o).abs();
+            (f, d_vis / (4.0 * dot_o.abs()) * pr / (pr + pt))
         } else {
-            let (wi, etap) = refract(wo, wm, self.eta)?;
-            if local::same_hemisphere(wo, wi) || wi.z == 0.0 {
-                return None;
-            }
             let dot_i = wi.dot(wm);
             let denom = sqr(dot_i + dot_o / etap);
-            let g = 1.0 / (1.0 + lambda_o + self.distrib.lambda(wi));
             // [Walter et al. 2007, eqs. 17 and 21]
-            let mut f = d * g * t * (dot_i * dot_o / (local::cos_theta(wi) * cos_o * denom)).abs();
+            let mut f = d * g * t * (dot_i * dot_o / (cos_i * cos_o * denom)).abs();
             if mode == TransportMode::Radiance {
                 f /= sqr(etap);
             }
-            let pdf = d_vis * dot_i.abs() / denom * pt / (pr + pt);
-            (wi, BxdfFlags::GLOSSY_TRANSMISSION, etap, f, pdf)
+            (f, d_vis * dot_i.abs() / denom * pt / (pr + pt))
         };
         (pdf > 0.0 && f.is_finite()).then(|| BsdfSample {
             f: SampledSpectrum::splat(f),
@@ -354,29 +353,26 @@ impl DielectricBxdf {
         })
     }
 
-    /// Visible-normal sample, then reflection or refraction by Fresnel.
-    ///
-    /// The returned value and density are `f(wo, wi)` and `pdf(wo, wi)` of the
-    /// chosen direction: recomputing them from the generalized half vector
-    /// rather than the sampled ωm keeps sample and evaluation identical under
-    /// float round-off, which MIS in BDPT relies on.
-    fn sample_rough(
+    /// A visible normal ωm, then reflection or refraction about it chosen by
+    /// Fresnel, with what [`Self::sample_rough`] and [`Self::sample_f_walk`]
+    /// each need to value it.
+    fn sample_rough_direction(
         &self,
         wo: Vec3,
         uc: f32,
         u: Vec2,
-        mode: TransportMode,
         allowed: SampleFlags,
-    ) -> Option<BsdfSample> {
+    ) -> Option<RoughSample> {
         if wo.z == 0.0 {
             return None;
         }
         let wm = self.distrib.sample_wm(wo, u);
-        let (pr, pt) = lobe_probs(
-            fr_dielectric(wo.dot(wm), self.eta),
-            ft_dielectric(wo.dot(wm), self.eta),
-            allowed,
+        let dot_o = wo.dot(wm);
+        let fresnel = (
+            fr_dielectric(dot_o, self.eta),
+            ft_dielectric(dot_o, self.eta),
         );
+        let (pr, pt) = lobe_probs(fresnel.0, fresnel.1, allowed);
         if pr == 0.0 && pt == 0.0 {
             return None;
         }
@@ -393,6 +389,33 @@ impl DielectricBxdf {
             }
             (wi, BxdfFlags::GLOSSY_TRANSMISSION, etap)
         };
+        Some(RoughSample {
+            wm,
+            wi,
+            flags,
+            etap,
+            fresnel,
+            probs: (pr, pt),
+        })
+    }
+
+    /// Visible-normal sample, then reflection or refraction by Fresnel.
+    ///
+    /// The returned value and density are `f(wo, wi)` and `pdf(wo, wi)` of the
+    /// chosen direction: recomputing them from the generalized half vector
+    /// rather than the sampled ωm keeps sample and evaluation identical under
+    /// float round-off, which MIS in BDPT relies on.
+    fn sample_rough(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        allowed: SampleFlags,
+    ) -> Option<BsdfSample> {
+        let RoughSample {
+            wi, flags, etap, ..
+        } = self.sample_rough_direction(wo, uc, u, allowed)?;
         // f and pdf as Self::f and Self::pdf give them, sharing the half
         // vector, D(ωm) and Λ(ωo) (the same operations, the same bits).
         let h = self.half_vector(wo, wi)?;
