@@ -19,7 +19,10 @@ at 1 and at 3 passes per binary; the instructions of one pass, (I3 - I1)/2, and
 the fixed part (parse, build, write), I1 - one pass, are given apart, since a
 slower BVH build and a faster pass would otherwise blur together. Instruction
 counts do not depend on machine load (they ignore cache and branch effects, so
-they are a second opinion beside the wall times, not a replacement).
+they are a second opinion beside the wall times, not a replacement). Valgrind
+does not decode every instruction of a `target-cpu=native` build on recent CPUs
+(AVX-512, GFNI): for `--callgrind` build both binaries with
+`RUSTFLAGS="-C target-cpu=x86-64-v3"` (the same images, bit for bit).
 
 SPPM is given an explicit radius and photon count so that both binaries do the
 same work whatever their defaults.

@@ -41,6 +41,7 @@
 use super::Light;
 use crate::math::{safe_sqrt, Bounds3, DirectionCone, Transform, Vec3};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use wide::{f32x4, CmpEq, CmpGt, CmpLe};
 
 /// The emission bounds of one light or of a set of lights.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -221,6 +222,110 @@ impl PreparedBounds {
             return if imp > 0.0 { f32::MAX } else { 0.0 };
         }
         (imp / d2).clamp(0.0, f32::MAX)
+    }
+}
+
+/// The prepared bounds of a light BVH node's two children side by side, one
+/// SIMD lane each, so that one evaluation gives both importances (the BVH
+/// light sampler needs both at every interior node it passes). Each field
+/// holds (first child, second child); lanes 2 and 3 compute on zeros and
+/// are ignored.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct PreparedPair {
+    pc: [[f32; 2]; 3],
+    r: [f32; 2],
+    r2: [f32; 2],
+    half_diagonal: [f32; 2],
+    w: [[f32; 2]; 3],
+    phi: [f32; 2],
+    cos_o: [f32; 2],
+    sin_o: [f32; 2],
+    cos_e: [f32; 2],
+    /// 1 for a two-sided child, else 0.
+    two_sided: [f32; 2],
+}
+
+/// Two values in the low lanes of a vector.
+#[inline(always)]
+fn lanes(a: [f32; 2]) -> f32x4 {
+    f32x4::from([a[0], a[1], 0.0, 0.0])
+}
+
+/// `safe_sqrt` lane by lane (`max` keeps the non-NaN operand, as `f32::max`).
+#[inline(always)]
+fn safe_sqrt4(x: f32x4) -> f32x4 {
+    x.max(f32x4::ZERO).sqrt()
+}
+
+impl PreparedPair {
+    /// The pair (a, b).
+    pub fn new(a: &PreparedBounds, b: &PreparedBounds) -> Self {
+        let f = |get: fn(&PreparedBounds) -> f32| [get(a), get(b)];
+        Self {
+            pc: [f(|x| x.pc.x), f(|x| x.pc.y), f(|x| x.pc.z)],
+            r: f(|x| x.r),
+            r2: f(|x| x.r2),
+            half_diagonal: f(|x| x.half_diagonal),
+            w: [f(|x| x.w.x), f(|x| x.w.y), f(|x| x.w.z)],
+            phi: f(|x| x.phi),
+            cos_o: f(|x| x.cos_o),
+            sin_o: f(|x| x.sin_o),
+            cos_e: f(|x| x.cos_e),
+            two_sided: f(|x| f32::from(u8::from(x.two_sided))),
+        }
+    }
+
+    /// Both children's [`PreparedBounds::importance`] at `p` with normal
+    /// `n`, bit for bit: the same operations in the same order, lane by
+    /// lane, with each branch turned into a blend of both outcomes (the
+    /// vector `max` keeps the non-NaN operand as `f32::max` does, and no
+    /// multiply-add is fused); the last steps run per lane as in the scalar.
+    #[inline]
+    pub fn importances(&self, p: Vec3, n: Vec3) -> [f32; 2] {
+        let (zero, one) = (f32x4::ZERO, f32x4::ONE);
+        let v = [p.x, p.y, p.z].map(f32x4::splat);
+        let v = [0, 1, 2].map(|k| v[k] - lanes(self.pc[k]));
+        let dist2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        let d2 = dist2.max(lanes(self.half_diagonal));
+        let inv_dist = dist2.cmp_gt(zero).blend(one / dist2.sqrt(), zero);
+        let wi = v.map(|c| c * inv_dist);
+        let inside = dist2.cmp_le(lanes(self.r2));
+        let sin_b_out = lanes(self.r) * inv_dist;
+        let sin_b = inside.blend(zero, sin_b_out);
+        let cos_b = inside.blend(f32x4::splat(-1.0), safe_sqrt4(one - sin_b_out * sin_b_out));
+        let w = self.w.map(lanes);
+        let cos_w = w[0] * wi[0] + w[1] * wi[1] + w[2] * wi[2];
+        let cos_w = lanes(self.two_sided).cmp_eq(zero).blend(cos_w, cos_w.abs());
+        let (cos_o, sin_o) = (lanes(self.cos_o), lanes(self.sin_o));
+        let sin_w = safe_sqrt4(one - cos_w * cos_w);
+        let cos_x = cos_w * cos_o + sin_w * sin_o;
+        let sin_x = sin_w * cos_o - cos_w * sin_o;
+        let cos_sub = cos_x
+            .cmp_gt(cos_b)
+            .blend(one, cos_x * cos_b + sin_x * sin_b);
+        let cos_p = cos_w.cmp_gt(cos_o).blend(one, cos_sub);
+        let dead = cos_p.cmp_le(lanes(self.cos_e)).move_mask();
+        let mut imp = lanes(self.phi) * cos_p;
+        if n != Vec3::ZERO {
+            let cos_i = (wi[0] * n.x + wi[1] * n.y + wi[2] * n.z).abs();
+            let sin_i = safe_sqrt4(one - cos_i * cos_i);
+            let scaled = imp * (cos_i * cos_b + sin_i * sin_b);
+            imp = cos_i.cmp_le(cos_b).blend(scaled, imp);
+        }
+        let (imp, d2) = (imp.to_array(), d2.to_array());
+        [0, 1].map(|k| {
+            if dead & (1 << k) != 0 {
+                0.0
+            } else if d2[k] == 0.0 {
+                if imp[k] > 0.0 {
+                    f32::MAX
+                } else {
+                    0.0
+                }
+            } else {
+                (imp[k] / d2[k]).clamp(0.0, f32::MAX)
+            }
+        })
     }
 }
 

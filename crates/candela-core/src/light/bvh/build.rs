@@ -26,6 +26,7 @@
 
 use super::compact::CompactLightBounds;
 use super::{LightBvhNode, Slot};
+use crate::light::bounds::PreparedBounds;
 use crate::light::LightBounds;
 use crate::math::{safe_sqrt, Bounds3, PI};
 
@@ -37,6 +38,8 @@ const MAX_DEPTH: u32 = 64;
 /// The tree under construction.
 pub(super) struct Builder<'a> {
     pub nodes: Vec<LightBvhNode>,
+    /// Each node's bounds, decoded from their compact form.
+    pub bounds: Vec<PreparedBounds>,
     pub slots: &'a mut [Slot],
     pub all: Bounds3,
 }
@@ -53,24 +56,27 @@ impl Builder<'_> {
         debug_assert!(!items.is_empty());
         if let [(light, lb)] = items {
             self.slots[*light as usize] = Slot::Tree(trail);
-            self.nodes.push(LightBvhNode::leaf(
-                *light,
-                CompactLightBounds::new(lb, &self.all),
-                &self.all,
-            ));
+            self.nodes.push(LightBvhNode::leaf(*light));
+            self.bounds.push(self.prepared(lb));
             return *lb;
         }
         let mid = split(items, depth);
         let index = self.nodes.len();
         self.nodes.push(LightBvhNode::default());
+        self.bounds.push(PreparedBounds::default());
         let (left, right) = items.split_at_mut(mid);
         let b0 = self.node(left, trail, depth + 1);
         let second = self.nodes.len() as u32;
         let b1 = self.node(right, trail | (1u64 << depth), depth + 1);
         let lb = b0.union(&b1);
-        self.nodes[index] =
-            LightBvhNode::interior(second, CompactLightBounds::new(&lb, &self.all), &self.all);
+        self.nodes[index] = LightBvhNode::interior(second);
+        self.bounds[index] = self.prepared(&lb);
         lb
+    }
+
+    /// `lb` as a node holds it: packed, decoded and prepared.
+    fn prepared(&self, lb: &LightBounds) -> PreparedBounds {
+        PreparedBounds::new(&CompactLightBounds::new(lb, &self.all).decode(&self.all))
     }
 }
 

@@ -37,41 +37,40 @@ mod compact;
 #[cfg(test)]
 mod tests;
 
-use super::bounds::PreparedBounds;
+use super::bounds::{PreparedBounds, PreparedPair};
 use super::{Light, LightSampleContext};
 use crate::interaction::LightId;
 use crate::math::{Bounds3, Vec3};
 use crate::sampling::ONE_MINUS_EPSILON;
-use compact::CompactLightBounds;
 
-/// A node: its bounds, decoded from their packed form (so importances
-/// are those of pbrt-v4's compact bounds) and prepared for [`importance`]
-/// once rather than at every evaluation, and the second child's index
-/// (interior) or the light's index (leaf).
-///
-/// [`importance`]: super::bounds::PreparedBounds::importance
+/// A node: the second child's index (interior) or the light's index
+/// (leaf), and for an interior node where its children's bounds are in
+/// [`BvhLightSampler::pairs`]. Bounds are those of pbrt-v4's compact
+/// bounds, decoded and prepared for the importance once, not at every
+/// evaluation.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct LightBvhNode {
-    bounds: PreparedBounds,
     /// Bit 31: leaf. Bits 0–30: light (leaf) or second child (interior).
     index: u32,
+    /// Interior nodes: index into `pairs`.
+    pair: u32,
 }
 
 const LEAF: u32 = 1 << 31;
 
 impl LightBvhNode {
-    fn leaf(light: u32, bounds: CompactLightBounds, all: &Bounds3) -> Self {
+    fn leaf(light: u32) -> Self {
         debug_assert!(light < LEAF);
         Self {
-            bounds: PreparedBounds::new(&bounds.decode(all)),
             index: light | LEAF,
+            pair: u32::MAX,
         }
     }
-    fn interior(second: u32, bounds: CompactLightBounds, all: &Bounds3) -> Self {
+    fn interior(second: u32) -> Self {
         debug_assert!(second < LEAF);
         Self {
-            bounds: PreparedBounds::new(&bounds.decode(all)),
             index: second,
+            pair: u32::MAX,
         }
     }
     #[inline]
@@ -99,6 +98,10 @@ enum Slot {
 #[derive(Clone, Debug)]
 pub struct BvhLightSampler {
     nodes: Vec<LightBvhNode>,
+    /// The children's bounds of each interior node, side by side.
+    pairs: Vec<PreparedPair>,
+    /// The root's bounds (a tree of one light needs them).
+    root: PreparedBounds,
     infinite: Vec<LightId>,
     slots: Vec<Slot>,
 }
@@ -125,15 +128,28 @@ impl BvhLightSampler {
         }
         let mut b = build::Builder {
             nodes: Vec::with_capacity(2 * items.len()),
+            bounds: Vec::with_capacity(2 * items.len()),
             slots: &mut slots,
             all,
         };
         if !items.is_empty() {
             b.node(&mut items, 0, 0);
         }
-        let nodes = b.nodes;
+        let (mut nodes, bounds) = (b.nodes, b.bounds);
+        let mut pairs = Vec::with_capacity(nodes.len() / 2);
+        for (i, node) in nodes.iter_mut().enumerate() {
+            if !node.is_leaf() {
+                node.pair = pairs.len() as u32;
+                pairs.push(PreparedPair::new(
+                    &bounds[i + 1],
+                    &bounds[node.target() as usize],
+                ));
+            }
+        }
         Self {
             nodes,
+            pairs,
+            root: bounds.first().copied().unwrap_or_default(),
             infinite,
             slots,
         }
@@ -151,18 +167,19 @@ impl BvhLightSampler {
         n / (n + if self.nodes.is_empty() { 0.0 } else { 1.0 })
     }
 
-    /// Importance of node `i` at the receiver.
+    /// Importance of the root at the receiver.
     #[inline]
-    fn importance(&self, i: usize, p: Vec3, n: Vec3) -> f32 {
-        self.nodes[i].bounds.importance(p, n)
+    fn root_importance(&self, p: Vec3, n: Vec3) -> f32 {
+        self.root.importance(p, n)
     }
 
     /// Probabilities of the two children of interior node `i`: I_k/(I₀ + I₁),
     /// or zeros when both importances are zero.
     #[inline]
     fn child_probabilities(&self, i: usize, p: Vec3, n: Vec3) -> [f32; 2] {
-        let c0 = self.importance(i + 1, p, n) as f64;
-        let c1 = self.importance(self.nodes[i].target() as usize, p, n) as f64;
+        let [c0, c1] = self.pairs[self.nodes[i].pair as usize]
+            .importances(p, n)
+            .map(f64::from);
         let sum = c0 + c1;
         if sum == 0.0 {
             return [0.0; 2];
@@ -189,7 +206,7 @@ impl BvhLightSampler {
         loop {
             let node = &self.nodes[i];
             if node.is_leaf() {
-                if i == 0 && self.importance(0, p, n) <= 0.0 {
+                if i == 0 && self.root_importance(p, n) <= 0.0 {
                     return None;
                 }
                 return Some((LightId(node.target()), pmf));
@@ -224,7 +241,7 @@ impl BvhLightSampler {
             let node = &self.nodes[i];
             if node.is_leaf() {
                 debug_assert_eq!(node.target(), light.0);
-                if i == 0 && self.importance(0, p, n) <= 0.0 {
+                if i == 0 && self.root_importance(p, n) <= 0.0 {
                     return 0.0;
                 }
                 return pmf;

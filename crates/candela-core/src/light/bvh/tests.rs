@@ -140,7 +140,7 @@ fn dead_end_mass(s: &BvhLightSampler, ctx: &LightSampleContext) -> f64 {
     fn walk(s: &BvhLightSampler, i: usize, mass: f64, ctx: &LightSampleContext) -> f64 {
         let node = &s.nodes[i];
         if node.is_leaf() {
-            let alive = i > 0 || s.importance(0, ctx.p, ctx.ns) > 0.0;
+            let alive = i > 0 || s.root_importance(ctx.p, ctx.ns) > 0.0;
             return if alive { 0.0 } else { mass };
         }
         let pr = s.child_probabilities(i, ctx.p, ctx.ns);
@@ -375,6 +375,59 @@ fn importance_is_zero_exactly_where_the_angle_bound_is() {
         zeros > 5_000 && checked - zeros > 5_000,
         "{zeros} of {checked}"
     );
+}
+
+/// Random bounds (boxes that may hold p or be a point, one- and two-sided,
+/// cones from a single direction to the whole sphere), points and normals
+/// (zero for free space): the pair evaluation gives each child's scalar
+/// importance bit for bit, so `sample` and `pmf`, which both use it, keep
+/// the probabilities pbrt-v4's scalar formula defines.
+#[test]
+fn pair_importances_are_the_scalar_ones_bit_for_bit() {
+    let mut r = Pcg32::new(11, 3);
+    let bounds = |r: &mut Pcg32| {
+        let (a, c) = (u3(r), u3(r) * r.uniform_f32());
+        let size = if r.uniform_f32() < 0.1 { 0.0 } else { 0.3 };
+        let lb = LightBounds::new(
+            Bounds3::from_points(a, a + c.abs() * size),
+            DirectionCone::new(dir(r), 2.0 * r.uniform_f32() - 1.0),
+            1.0 + r.uniform_f32(),
+            (2.0 * r.uniform_f32() - 1.0).max(0.0),
+            r.uniform_f32() < 0.3,
+        );
+        (lb, PreparedBounds::new(&lb))
+    };
+    let (mut positive, mut zero) = (0, 0);
+    for _ in 0..100_000 {
+        let ((la, a), (lb, b)) = (bounds(&mut r), bounds(&mut r));
+        let _ = &lb;
+        let p = match r.next_u32() % 4 {
+            0 => la.centroid(),
+            1 => la.bounds.min + (la.bounds.max - la.bounds.min) * r.uniform_f32(),
+            _ => 3.0 * u3(&mut r),
+        };
+        let n = if r.uniform_f32() < 0.3 {
+            Vec3::ZERO
+        } else {
+            dir(&mut r)
+        };
+        let got = PreparedPair::new(&a, &b).importances(p, n);
+        let want = [a.importance(p, n), b.importance(p, n)];
+        assert_eq!(
+            got.map(f32::to_bits),
+            want.map(f32::to_bits),
+            "{la:?} {lb:?} at {p:?}, n {n:?}"
+        );
+        for w in want {
+            if w > 0.0 {
+                positive += 1;
+            } else {
+                zero += 1;
+            }
+        }
+    }
+    // Both outcomes must be common for the comparison to mean anything.
+    assert!(positive > 5_000 && zero > 5_000, "{positive} {zero}");
 }
 
 /// Random cones and directions: anything in either cone is in the union.
