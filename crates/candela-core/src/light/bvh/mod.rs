@@ -44,10 +44,9 @@ use crate::math::{Bounds3, Vec3};
 use crate::sampling::ONE_MINUS_EPSILON;
 
 /// A node: the second child's index (interior) or the light's index
-/// (leaf), and for an interior node where its children's bounds are in
-/// [`BvhLightSampler::pairs`]. Bounds are those of pbrt-v4's compact
-/// bounds, decoded and prepared for the importance once, not at every
-/// evaluation.
+/// (leaf), and for an interior node the index of its children's bounds in
+/// the sampler's `pairs`. Bounds are those of pbrt-v4's compact bounds,
+/// decoded and prepared for the importance once, not at every evaluation.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct LightBvhNode {
     /// Bit 31: leaf. Bits 0–30: light (leaf) or second child (interior).
