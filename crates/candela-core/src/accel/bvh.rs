@@ -26,7 +26,16 @@ pub struct Bvh {
     items: usize,
     has_other: bool,
     depth: usize,
+    /// Prefetch children when pushing them: only for hierarchies larger
+    /// than [`PREFETCH_MIN_BYTES`].
+    prefetch: bool,
 }
+
+/// Below this size (nodes and packs) a hierarchy stays in the core's caches
+/// after a few rays, and prefetching the children a traversal pushes only
+/// costs instructions (about 8 % of a closest-hit query on the Cornell
+/// box's 36 triangles).
+const PREFETCH_MIN_BYTES: usize = 256 * 1024;
 
 /// The closest hit found by [`Bvh::intersect`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,6 +113,7 @@ impl Bvh {
         }
         bvh.nodes.shrink_to_fit();
         bvh.packs.shrink_to_fit();
+        bvh.prefetch = bvh.memory_bytes() >= PREFETCH_MIN_BYTES;
         bvh.has_other = bvh.packs.iter().any(|p| {
             p.ids
                 .iter()
@@ -162,6 +172,9 @@ impl Bvh {
     /// Prefetches the first cache lines of a child.
     #[inline(always)]
     fn prefetch_child(&self, code: u32) {
+        if !self.prefetch {
+            return;
+        }
         if code & LEAF_TAG == 0 {
             super::simd::prefetch_all(&self.nodes[code as usize]);
         } else {
