@@ -7,7 +7,7 @@
 //!   `Scene.files()` (or `scene_files(path)`, parsing only) lists every
 //!   file it reads;
 //! - `Scene.render(...) -> Render` renders a pass range with the GIL
-//!   released; Ctrl-C stops it ([`run`]);
+//!   released; Ctrl-C stops it (`run`);
 //! - a `Render`'s layers are numpy arrays; renders merge exactly, go to and
 //!   from bytes (the command line's `.cndl` state) and save as the EXR the
 //!   command line writes;

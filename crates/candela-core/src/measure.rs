@@ -22,7 +22,7 @@
 //!   L·cos θ/(P·p_l) weighted by the power heuristic against the cosine
 //!   density, while the emission the cosine ray finds at its first hit
 //!   takes the complementary weight [Veach 1997, eq. 9.13]
-//!   ([`PathIntegrator::li_sampled`]); lights no ray can hit (an area
+//!   (`PathIntegrator::li_sampled`); lights no ray can hit (an area
 //!   light of `alpha` 0) take full weight. Small luminaires are then found
 //!   by their samples, not by chance.
 //!
@@ -56,9 +56,9 @@ pub struct MeasureSettings {
 /// One measured point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measurement {
-    /// Estimated illuminance [lx].
+    /// Estimated illuminance \[lx\].
     pub illuminance: f64,
-    /// Its standard error [lx].
+    /// Its standard error \[lx\].
     pub stderr: f64,
 }
 
@@ -117,7 +117,7 @@ pub(crate) fn sensor_origin(scene: &crate::scene::Scene, p: Vec3, n: Vec3) -> Ve
     p + n * (1e-5 * size.max(1e-3))
 }
 
-/// One sample of E_v [lx] at `origin` on a sensor facing unit `n`, at the
+/// One sample of E_v \[lx\] at `origin` on a sensor facing unit `n`, at the
 /// wavelengths `lambda`, drawing the rest from `sampler` (already started
 /// at its sample): the delta-light part and the cosine-weighted path
 /// estimate of the module doc. `candela measure` averages these per point;

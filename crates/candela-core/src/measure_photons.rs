@@ -5,7 +5,7 @@
 //! ([`crate::integrator::photon::trace_photon`], the one light-subpath
 //! walker), each at its own four wavelengths drawn from the visible-range
 //! density, so a deposit's luminous power is K_m·(1/4) Σ_k ȳ(λ_k) β_k/p(λ_k)
-//! [lm] ([`crate::measure`]'s `luminous`), a scalar: irradiance needs no
+//! \[lm\] ([`crate::measure`]'s `luminous`), a scalar: irradiance needs no
 //! BSDF, so nothing spectral outlives the deposit. Every surface hit counts,
 //! the first one too (direct light; there is no next-event part here).
 //!
@@ -104,7 +104,7 @@ pub fn measure_photons(
     )
 }
 
-/// One illuminance estimate per point and PPM pass [lx].
+/// One illuminance estimate per point and PPM pass \[lx\].
 fn ppm_passes(scene: &Scene, s: &PhotonMeasureSettings, points: &[(Vec3, Vec3)]) -> Vec<Vec<f64>> {
     (0..u64::from(s.passes))
         .map(|pass| {
@@ -119,7 +119,7 @@ fn ppm_passes(scene: &Scene, s: &PhotonMeasureSettings, points: &[(Vec3, Vec3)])
         .collect()
 }
 
-/// One illuminance estimate per point and SPPM chain [lx].
+/// One illuminance estimate per point and SPPM chain \[lx\].
 fn sppm_chains(scene: &Scene, s: &PhotonMeasureSettings, points: &[(Vec3, Vec3)]) -> Vec<Vec<f64>> {
     let chains = s.passes.min(SPPM_CHAINS);
     let r0 = f64::from(s.radius);

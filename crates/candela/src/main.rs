@@ -47,7 +47,7 @@ enum Cmd {
     /// Merge partial renders (`render --pass-range`) of one scene exactly:
     /// the image equals one render of all their passes, bit for bit.
     Merge(render_cmd::MergeArgs),
-    /// Virtual illuminance meter: illuminance [lx] and its standard error at
+    /// Virtual illuminance meter: illuminance \[lx\] and its standard error at
     /// each point of `--points` (`x y z nx ny nz` per line), as CSV.
     Measure(measure_cmd::MeasureArgs),
 }

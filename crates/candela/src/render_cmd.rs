@@ -131,7 +131,7 @@ pub struct RenderArgs {
     pub aov: Option<AovList>,
     /// `sensor` (default): the film's sensor RGB. `photometric`: instead
     /// of RGB, the EXR holds `luminance.Y` [cd/m²] (683 lm/W × ∫L V dλ,
-    /// CIE 1931 V = ȳ), `illuminance.Y` [lx] (arriving at the first visible
+    /// CIE 1931 V = ȳ), `illuminance.Y` \[lx\] (arriving at the first visible
     /// surface of each pixel, from the side the camera sees; 0 where the
     /// ray escapes; Radiance's `rpict -i`) and their standard errors
     /// `luminance_stderr.Y`, `illuminance_stderr.Y` (√(s²/n) over the

@@ -182,7 +182,7 @@ fn ies_file(h: &[f64], planes: &[[f64; 3]]) -> String {
     )
 }
 
-/// (flux [lm] from `candela info`, E per POINTS_IES) for an IES file.
+/// (flux \[lm\] from `candela info`, E per POINTS_IES) for an IES file.
 fn ies_light(d: &PathBuf, text: &str) -> (f64, Vec<(f64, f64)>) {
     std::fs::write(d.join("t.ies"), text).unwrap();
     let scene = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n\

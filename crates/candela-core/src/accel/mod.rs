@@ -5,13 +5,13 @@
 //! Wald et al. 2014, "Embree: a kernel framework for efficient CPU ray
 //! tracing"):
 //!
-//! 1. **Binary SAH build** ([`build`]): binned over all three axes, with a
+//! 1. **Binary SAH build** (`build`): binned over all three axes, with a
 //!    leaf cost counted in packs of four primitives; it terminates on any
 //!    input, and its depth is bounded.
-//! 2. **Collapse** ([`bvh`]): each wide node takes the binary node's
+//! 2. **Collapse** (`bvh`): each wide node takes the binary node's
 //!    children and opens the largest interior one until it has eight.
 //!    Nodes hold their children's boxes quantised to bytes on a per-node
-//!    grid, conservatively ([`node`]: 96 bytes instead of 256 for full
+//!    grid, conservatively (`node`: 96 bytes instead of 256 for full
 //!    floats). Leaves hold one pack.
 //!
 //! Why eight, and why bytes: incoherent rays over a large mesh wait on
@@ -20,11 +20,11 @@
 //! nodes against 11.0 four-wide ones, for the same 1.26 triangle packs; the
 //! quantised nodes take 8 MB where full-precision ones took 21 MB, which
 //! cut the simulated cache misses of traversal by 36–45 % (callgrind) and
-//! its instructions by 13 %. The node kernels ([`simd`]) run in one AVX2
+//! its instructions by 13 %. The node kernels (`simd`) run in one AVX2
 //! register when the CPU has it (detected at run time), else in two SSE
 //! halves, with identical results.
 //!
-//! Triangles are copied into the leaves as [`triangle4`] packs: four
+//! Triangles are copied into the leaves as `triangle4` packs: four
 //! triangles' vertices in structure-of-arrays form, tested together by a
 //! SIMD version of the watertight test that rounds exactly as the scalar one
 //! does, so hits, `t` and barycentrics (and so the interaction's error

@@ -8,7 +8,7 @@ use crate::spectrum::SampledSpectrum;
 /// Lambertian reflector with albedo `r` (symmetric, so both transport modes agree).
 #[derive(Clone, Copy, Debug)]
 pub struct DiffuseBxdf {
-    /// Albedo ∈ [0,1] per wavelength.
+    /// Albedo ∈ \[0,1\] per wavelength.
     pub r: SampledSpectrum,
 }
 

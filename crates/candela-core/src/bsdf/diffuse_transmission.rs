@@ -11,9 +11,9 @@ use crate::spectrum::SampledSpectrum;
 /// Lambertian reflector and transmitter (symmetric: both modes agree).
 #[derive(Clone, Copy, Debug)]
 pub struct DiffuseTransmissionBxdf {
-    /// Reflectance ∈ [0,1].
+    /// Reflectance ∈ \[0,1\].
     pub r: SampledSpectrum,
-    /// Transmittance ∈ [0,1].
+    /// Transmittance ∈ \[0,1\].
     pub t: SampledSpectrum,
 }
 

@@ -4,7 +4,7 @@
 //!
 //! Everything not supported is an error naming the entity and its
 //! file:line:col; parameters nobody looked at become warnings. Every
-//! parameter is checked against its domain ([`check`]) and the large
+//! parameter is checked against its domain (`check`) and the large
 //! structures against a memory budget ([`budget`]) before they are
 //! allocated.
 
@@ -94,7 +94,7 @@ pub struct Overrides {
     /// `--aov`: extra film layers.
     pub aovs: Vec<crate::film::Aov>,
     /// `--units photometric`: luminance [cd/m²] and first-hit illuminance
-    /// [lx] layers with their standard errors instead of sensor RGB.
+    /// \[lx\] layers with their standard errors instead of sensor RGB.
     pub photometric: bool,
     /// `--memory-limit` in bytes (default: [`budget::DEFAULT_SHARE`] of
     /// physical memory). Not part of a render's identity: it only decides

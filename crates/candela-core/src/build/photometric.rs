@@ -16,10 +16,10 @@
 //!
 //! | parameter | lights | meaning |
 //! |---|---|---|
-//! | `candela` | point, spot, goniometric (image), projection | intensity [cd]: of a point light; of a spot on its axis; where the goniometric map or projector slide is 1 |
+//! | `candela` | point, spot, goniometric (image), projection | intensity \[cd\]: of a point light; of a spot on its axis; where the goniometric map or projector slide is 1 |
 //! | `luminance` | diffuse area, infinite | luminance [cd/m²] of the emitter (of an RGB (1,1,1) texel for images) |
-//! | `lumens` | point, spot, goniometric (image or IES), projection, diffuse area | total luminous flux [lm]; an area light's flux is shared by its shape's triangles in proportion to their areas |
-//! | `lux` | distant, infinite | illuminance [lx] on a surface facing a distant light, on an upward patch for an infinite light |
+//! | `lumens` | point, spot, goniometric (image or IES), projection, diffuse area | total luminous flux \[lm\]; an area light's flux is shared by its shape's triangles in proportion to their areas |
+//! | `lux` | distant, infinite | illuminance \[lx\] on a surface facing a distant light, on an upward patch for an infinite light |
 //!
 //! Each multiplies with `scale`, as pbrt-v4's `power` does. At most one may
 //! be given, and not together with `power` or `illuminance`. Distant and

@@ -46,7 +46,7 @@ impl SphericalCamera {
         }
     }
 
-    /// Camera-space direction of film point `uv` ∈ [0,1]² (y and z swapped as pbrt).
+    /// Camera-space direction of film point `uv` ∈ \[0,1\]² (y and z swapped as pbrt).
     fn direction(&self, uv: Vec2) -> Vec3 {
         let d = match self.mapping {
             SphericalMapping::Equirectangular => {
@@ -90,7 +90,7 @@ impl SphericalCamera {
     }
 }
 
-/// Wraps film coordinates outside [0,1]² (filter tails) back onto the square
+/// Wraps film coordinates outside \[0,1\]² (filter tails) back onto the square
 /// by the octahedral map's mirror symmetry, as pbrt's `WrapEqualAreaSquare`.
 fn wrap_unit(uv: Vec2) -> Vec2 {
     let mut p = uv;

@@ -17,7 +17,7 @@
 //!
 //! Photometric films (`--units photometric`) have no R, G, B: their main
 //! layers are `luminance.Y` [cd/m²] (Σw·Y_v/Σw + Σdirect Y_v/n, see
-//! [`super::layout`]) and `illuminance.Y` [lx] (Σw_E·E_v/Σw_E), each with
+//! [`super::layout`]) and `illuminance.Y` \[lx\] (Σw_E·E_v/Σw_E), each with
 //! its standard error `luminance_stderr.Y`, `illuminance_stderr.Y` =
 //! √(s²/n) from the per-pass values (0 before 2 passes). The units are in
 //! [`Developed::units`], per layer, for the EXR header.

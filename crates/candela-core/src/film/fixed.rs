@@ -33,7 +33,7 @@ fn exp2i(e: i32) -> f64 {
 /// 2^53: every f64 of at least this magnitude is an integer.
 const INTEGRAL: f64 = 9_007_199_254_740_992.0;
 
-/// round(v·2^bits) (halves away from zero), clamped to ±[`LIMIT`];
+/// round(v·2^bits) (halves away from zero), clamped to ±`LIMIT`;
 /// non-finite values give 0 (the film drops and counts them before they
 /// get here).
 ///

@@ -9,8 +9,8 @@
 //! | spectral | Σw·L̄_b, then Σdirect L̄_b, per bucket | Σw·L̄_b/Σw + Σdirect L̄_b/passes |
 //! | surface | Σw, then Σw·x for each requested first-hit value | Σw·x/Σw (normals normalised) |
 //! | strategies | Σdirect rgb (3) per BDPT strategy | Σ/passes |
-//! | photometric | Σw·Y_v, Σdirect Y_v, Σw_E, Σw_E·E_v | Σw·Y_v/Σw + Σdirect/passes [cd/m²]; Σw_E·E_v/Σw_E [lx] |
-//! | variance (state only) | Σv (3), Σv² (3) of per-pass pixel values v | see [`super::state`] |
+//! | photometric | Σw·Y_v, Σdirect Y_v, Σw_E, Σw_E·E_v | Σw·Y_v/Σw + Σdirect/passes [cd/m²]; Σw_E·E_v/Σw_E \[lx\] |
+//! | variance (state only) | Σv (3), Σv² (3) of per-pass pixel values v | see `super::state` |
 //! | photometric variance (state only) | Σv, Σv² of per-pass luminance, then of illuminance | √(s²/n) |
 //!
 //! "Weighted" channels hold filtered camera samples (pbrt-v4's

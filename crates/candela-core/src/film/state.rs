@@ -251,7 +251,7 @@ fn pass_value(s: &[f64], m: &[[f64; 3]; 3]) -> [f64; 3] {
     [0, 1, 2].map(|r| (0..3).map(|c| m[r][c] * sensor[c]).sum())
 }
 
-/// The pass's own luminance [cd/m²] and first-hit illuminance [lx] of one pixel.
+/// The pass's own luminance [cd/m²] and first-hit illuminance \[lx\] of one pixel.
 fn photometric_pass_values(s: &[f64], layout: &FilmLayout) -> [f64; 2] {
     use super::layout::photo;
     let o = layout.photometric_offset();

@@ -176,7 +176,7 @@ impl FilmTile {
         }
     }
 
-    /// Adds the illuminance `e` [lx] at the first visible surface of one
+    /// Adds the illuminance `e` \[lx\] at the first visible surface of one
     /// camera ray with filter weight `weight` (`None`: the ray escaped and
     /// adds its weight only). Ignored without photometric layers;
     /// non-finite values are dropped and counted.

@@ -110,7 +110,7 @@ pub fn gather(x: &Surfel, ph: &Surfel, r2: f32) -> Option<Counted> {
 }
 
 /// Applies the rotation taking unit vector `a` to unit vector `b` to `v`
-/// [Rodrigues]: R v = (a·b) v + (a×b)×v + (a×b)((a×b)·v)/(1 + a·b);
+/// \[Rodrigues\]: R v = (a·b) v + (a×b)×v + (a×b)((a×b)·v)/(1 + a·b);
 /// the identity when a ≈ b.
 pub fn rotate_between(v: Vec3, a: Vec3, b: Vec3) -> Vec3 {
     let c = a.dot(b);

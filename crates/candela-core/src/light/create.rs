@@ -290,7 +290,7 @@ pub fn goniometric_light(
     GoniometricLight::new(t, i, sc, Arc::new(y_map))
 }
 
-/// `"goniometric"` with an IES LM-63 `web` [cd]: photometric nadir along
+/// `"goniometric"` with an IES LM-63 `web` \[cd\]: photometric nadir along
 /// `to − from`, horizontal angle 0 along light-space +x projected
 /// perpendicular to it (+y when `to − from` is along ±x). The web is
 /// absolute, so `scale·I` only sets the colour: I_v(ω) = scale·I_web(ω)

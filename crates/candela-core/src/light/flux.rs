@@ -1,6 +1,6 @@
 //! A light's total flux in radiometric and photometric units.
 //!
-//! Φ_e = ∫ Φ(λ) dλ [W] and Φ_v = K_m ∫ Φ(λ) V(λ) dλ [lm], V = ȳ of the CIE
+//! Φ_e = ∫ Φ(λ) dλ \[W\] and Φ_v = K_m ∫ Φ(λ) V(λ) dλ \[lm\], V = ȳ of the CIE
 //! 1931 observer and K_m = 683 lm/W [CIE S 017/E:2011, 17-21-039], summed
 //! over 360–830 nm at 1 nm (the spacing of the CIE tables, so the sum is
 //! the tables' own integral). Distant and infinite lights report the flux
@@ -14,9 +14,9 @@ use crate::spectrum::{
 /// Total flux of a light.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Flux {
-    /// Radiant flux [W] over 360–830 nm.
+    /// Radiant flux \[W\] over 360–830 nm.
     pub watts: f64,
-    /// Luminous flux [lm].
+    /// Luminous flux \[lm\].
     pub lumens: f64,
 }
 

@@ -19,7 +19,7 @@
 //! `β₀ = I/p_dir = Φ` for every sample.
 //!
 //! **IES webs.** The same light may instead carry an [`IesWeb`] (an IES
-//! LM-63 file): `Y(ω)` is then the web's bilinear intensity [cd] in the
+//! LM-63 file): `Y(ω)` is then the web's bilinear intensity \[cd\] in the
 //! light frame (nadir +z, horizontal angle 0 +x), emission sampling is the
 //! web's own ∝ I(ω), and Φ = scale·I_e·∫I dω with the web's exact flux.
 
@@ -55,7 +55,7 @@ enum Pattern {
         distribution: Arc<Distribution2D>,
         mean_y: f32,
     },
-    /// An IES photometric web [cd].
+    /// An IES photometric web \[cd\].
     Web(Arc<IesWeb>),
 }
 

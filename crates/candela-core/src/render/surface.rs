@@ -10,7 +10,7 @@
 //! integrator's own sample values cannot change: they are pure functions of
 //! (pixel, pass, dimension). The ray is followed through interface
 //! materials to the first surface with a BSDF, and the values are added
-//! with the sample's filter weight ([`FilmTile::add_surface`]); a ray that
+//! with the sample's filter weight (`FilmTile::add_surface`); a ray that
 //! escapes adds zeros with its weight (pbrt-v4's `GBufferFilm` divides by
 //! every sample's weight too).
 //!
@@ -29,7 +29,7 @@
 //!   are per pixel).
 //!
 //! **Illuminance** (photometric films, `--units photometric`): at the same
-//! first surface, one sample per pass of E_v [lx] arriving from the side
+//! first surface, one sample per pass of E_v \[lx\] arriving from the side
 //! the camera sees (the geometric normal turned towards the ray), by the
 //! very estimator of `candela measure` ([`crate::measure`]: delta lights
 //! by shadow rays plus a cosine-weighted path-traced direction, at the

@@ -42,7 +42,7 @@ pub enum ZSobolRandomize {
     /// Every binary digit flipped by a hashed bit per dimension (a random
     /// digital shift in base 2).
     PermuteDigits,
-    /// A nested uniform scramble by the hash of [`owen_scramble`] (the default).
+    /// A nested uniform scramble by the hash of `owen_scramble` (the default).
     FastOwen,
     /// Owen's scramble bit by bit: each bit flipped by a hash of the bits
     /// above it.

@@ -13,7 +13,7 @@
 //! pbrt-v4's `bsdfs_test.cpp`, written for candela.
 //!
 //! A run fails when p < α′ (callers testing m configurations at family level
-//! α pass α′ = [`sidak_alpha`]`(α, m)` [Šidák 1967]), when the density integrates
+//! α pass α′ = `sidak_alpha(α, m)` [Šidák 1967]), when the density integrates
 //! above 1 + 10⁻³ (beyond quadrature error), when a cell whose density
 //! integrates to zero receives samples, or when a sample is not a unit vector.
 

@@ -105,7 +105,7 @@ pub fn sample_exponential(u: f32, a: f32) -> f32 {
     -(1.0 - u).ln() / a
 }
 
-/// Samples the tent / linear density on [0,1] proportional to lerp(x, a, b).
+/// Samples the tent / linear density on \[0,1\] proportional to lerp(x, a, b).
 #[inline]
 pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
     if u == 0.0 && a == 0.0 {
@@ -160,7 +160,7 @@ pub fn invert_linear_sample(x: f32, a: f32, b: f32) -> f32 {
     x * (a * (2.0 - x) + b * x) / (a + b)
 }
 
-/// Samples the density on [0,1]² proportional to the bilinear interpolant of
+/// Samples the density on \[0,1\]² proportional to the bilinear interpolant of
 /// the corner values `w` = [w(0,0), w(1,0), w(0,1), w(1,1)]: the marginal in
 /// y is linear, the conditional in x is linear [pbrt-v4 §A.4.3]. Uniform
 /// when all weights are zero.
@@ -177,7 +177,7 @@ pub fn sample_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
     Vec2::new(x, y)
 }
 
-/// Density of [`sample_bilinear`]: 4·bilerp(p, w)/Σw, zero outside [0,1]².
+/// Density of [`sample_bilinear`]: 4·bilerp(p, w)/Σw, zero outside \[0,1\]².
 pub fn bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
     if !(0.0..=1.0).contains(&p.x) || !(0.0..=1.0).contains(&p.y) {
         return 0.0;

@@ -1,5 +1,5 @@
 //! The traceable scene: primitives in a BVH, materials, lights and the
-//! light sampler. Built from a plain description by [`build`].
+//! light sampler. Built from a plain description by `build`.
 
 mod motion;
 mod primitive;

@@ -2,7 +2,7 @@
 //! inverse of the bilinear map.
 //!
 //! A patch with corners p₀₀, p₁₀, p₀₁, p₁₁ is
-//! p(u, v) = lerp(v, lerp(u, p₀₀, p₁₀), lerp(u, p₀₁, p₁₁)) on [0,1]².
+//! p(u, v) = lerp(v, lerp(u, p₀₀, p₁₀), lerp(u, p₀₁, p₁₁)) on \[0,1\]².
 //!
 //! **Intersection** follows Reshetov 2019, "Cool Patches: A Geometric
 //! Approach to Ray/Bilinear Patch Intersections" (Ray Tracing Gems, ch. 8),
@@ -46,7 +46,7 @@ const EDGE_EPS: f64 = 1e-9;
 /// Parameters of a ray–patch hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BilinearIntersection {
-    /// Patch parameters (u, v) ∈ [0,1]².
+    /// Patch parameters (u, v) ∈ \[0,1\]².
     pub uv: Vec2,
     /// Ray parameter.
     pub t: f32,
@@ -195,7 +195,7 @@ pub fn patch_area(p: &[Vec3; 4]) -> f32 {
     (0.25 * sum) as f32
 }
 
-/// The (u, v) ∈ [0,1]² with bilerp(`t`, (u, v)) = `p` for 2D corner values
+/// The (u, v) ∈ \[0,1\]² with bilerp(`t`, (u, v)) = `p` for 2D corner values
 /// `t` = [t₀₀, t₁₀, t₀₁, t₁₁] [Quílez 2010]; `None` if no solution lies in
 /// (or within 1e-4 of) the square.
 pub fn invert_bilinear(p: Vec2, t: &[Vec2; 4]) -> Option<Vec2> {

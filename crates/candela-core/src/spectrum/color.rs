@@ -213,7 +213,7 @@ impl ColorSpace {
         Rgb::new(v.x, v.y, v.z)
     }
 
-    /// Sigmoid-polynomial coefficients of an RGB in [0,1]³, fitted on demand
+    /// Sigmoid-polynomial coefficients of an RGB in \[0,1\]³, fitted on demand
     /// by Gauss–Newton [Jakob & Hanika 2019] and memoised per distinct RGB.
     pub fn to_rgb_coeffs(&self, rgb: Rgb) -> RgbSigmoidPolynomial {
         let rgb = Rgb::new(

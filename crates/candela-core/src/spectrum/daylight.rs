@@ -26,7 +26,7 @@ pub fn daylight_cct(t: f32) -> f32 {
 }
 
 /// Chromaticity (x_D, y_D) of CIE daylight at correlated colour temperature
-/// `cct` [K] (the CIE formula; meaningful for 4000 K ≤ cct ≤ 25000 K).
+/// `cct` \[K\] (the CIE formula; meaningful for 4000 K ≤ cct ≤ 25000 K).
 pub fn daylight_xy(cct: f32) -> (f32, f32) {
     let t = cct as f64;
     let x = if t <= 7000.0 {
@@ -39,7 +39,7 @@ pub fn daylight_xy(cct: f32) -> (f32, f32) {
 }
 
 /// pbrt-v4's `Spectra::D(t)`: the daylight spectrum for nominal temperature
-/// `t` [K], scaled to ≈ 1 at 560 nm (a peak-normalised blackbody below 4000 K).
+/// `t` \[K\], scaled to ≈ 1 at 560 nm (a peak-normalised blackbody below 4000 K).
 pub fn daylight(t: f32) -> PiecewiseLinear {
     let cct = daylight_cct(t);
     if cct < 4000.0 {

@@ -36,7 +36,7 @@ pub const CIE_Y_INTEGRAL: f32 = 106.856_895;
 /// Maximum luminous efficacy [lm/W].
 pub const K_M: f32 = 683.0;
 
-/// CIE 1931 colour-matching functions at wavelength `lambda` [nm] (linear between 1 nm samples).
+/// CIE 1931 colour-matching functions at wavelength `lambda` \[nm\] (linear between 1 nm samples).
 pub fn cie_xyz(lambda: f32) -> [f32; 3] {
     if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lambda) {
         return [0.0; 3];

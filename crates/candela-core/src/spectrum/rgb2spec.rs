@@ -197,7 +197,7 @@ fn gauss_newton(mut c: [f64; 3], target: [f64; 3], w: &[[f64; 3]]) -> [f64; 3] {
     c
 }
 
-/// Fits the sigmoid polynomial of an RGB in [0,1]³ for colour space `cs`.
+/// Fits the sigmoid polynomial of an RGB in \[0,1\]³ for colour space `cs`.
 pub fn fit_sigmoid(cs: &ColorSpace, rgb: Rgb) -> RgbSigmoidPolynomial {
     let w = spectral_weights(cs);
     let target = [rgb.r as f64, rgb.g as f64, rgb.b as f64];

@@ -9,9 +9,9 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Index, IndexMut, Mul, MulAssign, 
 
 /// Number of wavelengths carried by each path.
 pub const N_SPECTRUM_SAMPLES: usize = 4;
-/// Shortest wavelength considered by the renderer [nm].
+/// Shortest wavelength considered by the renderer \[nm\].
 pub const LAMBDA_MIN: f32 = 360.0;
-/// Longest wavelength considered by the renderer [nm].
+/// Longest wavelength considered by the renderer \[nm\].
 pub const LAMBDA_MAX: f32 = 830.0;
 
 /// Values of a spectral quantity at the path's sampled wavelengths.
@@ -216,12 +216,12 @@ impl SampledWavelengths {
         Self { lambda, pdf }
     }
 
-    /// Wavelength `i` [nm].
+    /// Wavelength `i` \[nm\].
     #[inline]
     pub fn lambda(&self, i: usize) -> f32 {
         self.lambda[i]
     }
-    /// All wavelengths [nm].
+    /// All wavelengths \[nm\].
     #[inline]
     pub fn lambdas(&self) -> &[f32; N_SPECTRUM_SAMPLES] {
         &self.lambda

@@ -41,7 +41,7 @@ impl PiecewiseLinear {
             values,
         }
     }
-    /// From evenly spaced values starting at `start` with step `step` [nm].
+    /// From evenly spaced values starting at `start` with step `step` \[nm\].
     pub fn from_even(start: f32, step: f32, values: &[f32]) -> Self {
         let lambda: Vec<f32> = (0..values.len()).map(|i| start + step * i as f32).collect();
         Self {
@@ -141,9 +141,9 @@ pub enum Spectrum {
     Constant(f32),
     /// Tabulated, linearly interpolated.
     PiecewiseLinear(Arc<PiecewiseLinear>),
-    /// Planck's law at temperature `t` [K], scaled so its peak is 1 (pbrt-v4 `BlackbodySpectrum`).
+    /// Planck's law at temperature `t` \[K\], scaled so its peak is 1 (pbrt-v4 `BlackbodySpectrum`).
     Blackbody {
-        /// Temperature [K].
+        /// Temperature \[K\].
         t: f32,
         /// 1 / peak radiance.
         normalization: f32,
@@ -169,7 +169,7 @@ pub enum Spectrum {
 }
 
 impl Spectrum {
-    /// Value at wavelength `lambda` [nm].
+    /// Value at wavelength `lambda` \[nm\].
     pub fn eval(&self, lambda: f32) -> f32 {
         match self {
             Spectrum::Constant(c) => *c,
@@ -261,7 +261,7 @@ fn scaled_coeffs(cs: &'static ColorSpace, rgb: Rgb) -> (RgbSigmoidPolynomial, f3
     (cs.to_rgb_coeffs(rgb), scale)
 }
 
-/// Blackbody spectral radiance at `lambda_nm` and temperature `t` [K] (Planck's law, W/(m²·sr·m)).
+/// Blackbody spectral radiance at `lambda_nm` and temperature `t` \[K\] (Planck's law, W/(m²·sr·m)).
 pub fn planck(lambda_nm: f32, t: f32) -> f32 {
     if t <= 0.0 {
         return 0.0;

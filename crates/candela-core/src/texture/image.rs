@@ -118,7 +118,7 @@ impl ImageTexture {
         }
     }
 
-    /// Float value at a hit ([`Self::lookup_float`]), scaled, inverted as
+    /// Float value at a hit (`Self::lookup_float`), scaled, inverted as
     /// 1 − v clamped at 0.
     pub fn evaluate_float(&self, ctx: &TextureEvalContext) -> f32 {
         let raw = self.lookup_float(self.st(ctx));

@@ -61,7 +61,7 @@ pub fn t5_cube_world(rho: f64) -> String {
     )
 }
 
-/// T5's area-mean illuminance Φ/(S(1 − ρ)) [lx] of [`t5_cube_world`].
+/// T5's area-mean illuminance Φ/(S(1 − ρ)) \[lx\] of [`t5_cube_world`].
 #[allow(dead_code)]
 pub fn t5(rho: f64) -> f64 {
     10_000.0 / (96.0 * (1.0 - rho))

@@ -71,7 +71,7 @@ pub struct Photon {
     pub wi: Vec3,
     /// Geometric normal of the surface it landed on.
     pub n: Vec3,
-    /// Power ΔΦ at the pass wavelengths [W], already divided by the paths shot.
+    /// Power ΔΦ at the pass wavelengths \[W\], already divided by the paths shot.
     pub power: SampledSpectrum,
     /// Surfaces hit so far, this one included (1: direct illumination).
     pub depth: u32,

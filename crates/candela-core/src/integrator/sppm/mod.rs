@@ -18,7 +18,7 @@
 //!
 //! **PPM** (Knaus & Zwicker) makes every pass an independent estimate with
 //! one global radius r_i, r²_{i+1} = r²_i (i + α)/(i + 1) (closed form in
-//! [`ppm_radius2`]), and averages the passes ([`ppm`]).
+//! [`ppm_radius2`]), and averages the passes (`ppm`).
 
 pub mod passes;
 mod ppm;

@@ -8,7 +8,7 @@
 //! scattering ([`Scatter`]) before the next hit, whose direction gives the
 //! geometric outgoing cosine at the previous vertex; the update of eqs.
 //! 34–36 is applied there, then the arrival (distance², cosine) of the new
-//! vertex. Every chunk of [`CHUNK`] paths is a task; the chunks are kept in
+//! vertex. Every chunk of `CHUNK` paths is a task; the chunks are kept in
 //! path order and their splats summed in that order by the film's bands
 //! ([`PassSplats`]), so the stored vertices and splats do not depend on the
 //! thread count. (Until stop 37 chunks of 4096 ran on eight fixed lanes,

@@ -18,8 +18,8 @@
 //! subpaths (default one per pixel of the full film), stores their
 //! non-specular vertices with their MIS quantities, and splats their
 //! connections to the camera; (2) a `HashGrid` over the stored vertices
-//! with cells of 2r, and compact copies of them in its order ([`merge`]);
-//! (3) [`camera`] walks one camera subpath per pixel, connecting to the light subpath of the same index and merging with every
+//! with cells of 2r, and compact copies of them in its order (`merge`);
+//! (3) `camera` walks one camera subpath per pixel, connecting to the light subpath of the same index and merging with every
 //! stored vertex within r. The radius of pass i (0-based) is
 //! r_i² = r₀² Π_{k=1}^{i} (k + α)/(k + 1) [Knaus & Zwicker 2011, eq. 16],
 //! candela's `ppm` schedule, so pass i depends on i alone: passes are

@@ -21,7 +21,7 @@
 //! image. A pilot light pass
 //! (a fixed pass index of its own, so every process of a `--pass-range`
 //! render finds the same radius and passes stay independent) stores its
-//! vertices; around every `stride`-th of them (at most [`QUERIES`]) the
+//! vertices; around every `stride`-th of them (at most `QUERIES`) the
 //! vertices within a probe radius R are counted, and with the median count
 //! m (itself excluded) the radius is R √(K / m), since on surfaces the
 //! count grows as r². It is kept within [`MIN_FOOTPRINTS`, `MAX_FOOTPRINTS`]

@@ -1,4 +1,4 @@
-//! The photometric web of an IES LM-63 file: luminous intensity I(ω) [cd]
+//! The photometric web of an IES LM-63 file: luminous intensity I(ω) \[cd\]
 //! over the whole sphere, its flux, and emission sampling ∝ I.
 //!
 //! **Light frame.** Photometric zero (type C nadir, vertical angle 0) is the
@@ -89,7 +89,7 @@ pub struct IesWeb {
     periodic: bool,
     /// Polar angles ϑ [rad], increasing, in [0, π].
     polar: Vec<f64>,
-    /// Intensities [cd] at the nodes, `values[j * polar.len() + i]`.
+    /// Intensities \[cd\] at the nodes, `values[j * polar.len() + i]`.
     values: Vec<f64>,
     /// Exact ∫ I dω over cell (j, i), `cell_flux[j * (polar.len() - 1) + i]`.
     cell_flux: Vec<f64>,
@@ -214,12 +214,12 @@ impl IesWeb {
         }
     }
 
-    /// Luminous intensity [cd] towards unit light-frame direction `w`.
+    /// Luminous intensity \[cd\] towards unit light-frame direction `w`.
     pub fn intensity(&self, w: Vec3) -> f32 {
         self.locate(w).map_or(0.0, |c| self.bilinear(c) as f32)
     }
 
-    /// Total luminous flux Φ = ∫ I dω [lm] of the interpolated web (exact).
+    /// Total luminous flux Φ = ∫ I dω \[lm\] of the interpolated web (exact).
     pub fn flux(&self) -> f64 {
         self.flux
     }

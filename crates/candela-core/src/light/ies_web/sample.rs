@@ -19,7 +19,7 @@ pub struct IesSample {
     pub w: Vec3,
     /// Its density per unit solid angle (= [`IesWeb::pdf`]`(w)`).
     pub pdf: PdfSolidAngle,
-    /// Intensity towards `w` [cd] (= [`IesWeb::intensity`]`(w)`).
+    /// Intensity towards `w` \[cd\] (= [`IesWeb::intensity`]`(w)`).
     pub intensity: f32,
 }
 

@@ -1428,7 +1428,7 @@ pub const CIE_Z: [f32; 471] = [
     0.000000000e+00,
 ];
 
-/// First wavelength of the `D65` table [nm].
+/// First wavelength of the `D65` table \[nm\].
 pub const D65_START: f32 = 300.0;
 /// CIE standard illuminant D65, relative spectral power at 5 nm steps from 300 nm.
 pub const ILLUM_D65: [f32; 107] = [
@@ -1541,7 +1541,7 @@ pub const ILLUM_D65: [f32; 107] = [
     6.338280000e+01,
 ];
 
-/// First wavelength of the `D50` table [nm].
+/// First wavelength of the `D50` table \[nm\].
 pub const D50_START: f32 = 300.0;
 /// CIE standard illuminant D50, relative spectral power at 5 nm steps from 300 nm.
 pub const ILLUM_D50: [f32; 107] = [

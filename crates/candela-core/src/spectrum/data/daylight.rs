@@ -7,7 +7,7 @@
 
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
-/// First wavelength of the S basis and of ACES D60 [nm]; both step by 5 nm.
+/// First wavelength of the S basis and of ACES D60 \[nm\]; both step by 5 nm.
 pub const S_START: f32 = 300.0;
 
 /// S₀(λ), the mean daylight component.

@@ -1,8 +1,8 @@
 //! Optical constants of the remaining named spectra of pbrt-v4
 //! (`src/pbrt/util/spectrum.cpp`): MgO and TiO2 (`metal-MgO-*`,
 //! `metal-TiO2-*`), and the Schott glasses SF5, SF10, SF11 (`glass-F5`,
-//! `glass-F10`, `glass-F11`; pbrt-v4 cites https://refractiveindex.info,
-//! public domain CC0). (λ [nm], value) pairs.
+//! `glass-F10`, `glass-F11`; pbrt-v4 cites <https://refractiveindex.info>,
+//! public domain CC0). (λ \[nm\], value) pairs.
 
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 

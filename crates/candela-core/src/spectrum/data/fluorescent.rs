@@ -5,7 +5,7 @@
 // Measured values: some happen to be close to π or τ, which clippy flags.
 #![allow(clippy::approx_constant)]
 
-/// First wavelength [nm]; samples step by 5 nm.
+/// First wavelength \[nm\]; samples step by 5 nm.
 pub const F_START: f32 = 380.0;
 
 /// F1–F12 in order.

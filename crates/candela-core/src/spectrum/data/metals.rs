@@ -4,7 +4,7 @@
 // Measured values: some happen to be close to π-like constants, which clippy flags.
 #![allow(clippy::excessive_precision, clippy::approx_constant)]
 
-/// Wavelengths of the copper samples [nm].
+/// Wavelengths of the copper samples \[nm\].
 pub const CU_LAMBDA: [f32; 56] = [
     298.7570554,
     302.4004341,

@@ -7,7 +7,7 @@
 // Measured values: one happens to be close to 1/π, which clippy flags.
 #![allow(clippy::approx_constant)]
 
-/// First wavelength [nm]; samples step by 10 nm.
+/// First wavelength \[nm\]; samples step by 10 nm.
 pub const SWATCH_START: f32 = 380.0;
 
 /// The 24 patches in chart order (dark skin … black).
