@@ -13,9 +13,8 @@
 //! f̂_L = f·|ωo·ns||ωi·ng|/|ωo·ng| is the light-side BSDF with the adjoint
 //! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
 
-use super::density::{emitted, pdf_light_origin};
-use super::mis::{mis_weight, MisHeuristic, PathView};
-use crate::bsdf::TransportMode;
+use super::density::{emitted, join_end, pdf_light_origin};
+use super::mis::{mis_weight, JoinDensities, MisHeuristic, PathView};
 use crate::camera::Camera;
 use crate::integrator::lt_weights::LtWeights;
 use crate::integrator::nee::{sample_light, Receiver};
@@ -152,6 +151,7 @@ fn connect_emitter(cx: &ConnectCtx<'_>, cam: &[Vertex], t: usize) -> Option<Cont
             t,
             light_end: None,
             cam_end: Some(e),
+            join: None,
         };
         out.unweighted += c;
         let (w, w0) = cx.weights(&view, None);
@@ -220,6 +220,7 @@ fn connect_camera<R>(
         t: 1,
         light_end: None,
         cam_end: Some(lens),
+        join: None,
     };
     Some(k((c, Some(cs.p_raster)), &view))
 }
@@ -249,6 +250,7 @@ fn connect_light<R>(
         t,
         light_end: Some(e),
         cam_end: None,
+        join: None,
     };
     Some(k((c, None), &view))
 }
@@ -273,8 +275,11 @@ fn connect_inner<R>(
         return None;
     }
     let w = d / d2.sqrt();
-    let f_cam = cb.f(cv.wo, -w, TransportMode::Radiance) * w.dot(cv.ns).abs();
-    let c = lv.beta * lv.f_adjoint_cos(w) * f_cam * cv.beta / d2;
+    let (l_end, c_end) = (
+        join_end(lv, lb, w, cv.it.n, d2),
+        join_end(cv, cb, -w, lv.it.n, d2),
+    );
+    let c = lv.beta * l_end.f_cos * c_end.f_cos * cv.beta / d2;
     if c.is_black() || !cx.scene.unoccluded(&lv.it, &cv.it) {
         return None;
     }
@@ -285,6 +290,7 @@ fn connect_inner<R>(
         t,
         light_end: None,
         cam_end: None,
+        join: Some(JoinDensities::of_ends(&l_end, &c_end)),
     };
     Some(k((c, None), &view))
 }

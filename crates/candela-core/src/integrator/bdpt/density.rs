@@ -4,9 +4,9 @@
 //! `PdfLightOrigin`]. Conventions (area measure, vertices at infinity) are
 //! those of [`crate::integrator::subpath::Vertex`].
 
-use crate::bsdf::{SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
 use crate::camera::Camera;
-use crate::integrator::subpath::{dir, to_area, Vertex, VertexKind};
+use crate::integrator::subpath::{adjoint_cos, dir, to_area, Vertex, VertexKind};
 use crate::light::LightType;
 use crate::math::{Ray, Vec3};
 use crate::scene::Scene;
@@ -55,6 +55,50 @@ pub(crate) fn pdf_scatter_pair(
     let pair = bsdf.local_pair(dir(cur, prev), dir(cur, next));
     let (fwd, rev) = bsdf.pdfs_pair(&pair, mode);
     (to_area(fwd, cur, next).0, to_area(rev, cur, prev).0)
+}
+
+/// One end of a connection between two surface vertices, evaluated from one
+/// frame change: what the contribution and the MIS weight need of it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct JoinEnd {
+    /// f·|cos θ| towards the other end: for a light-subpath vertex f̂ with
+    /// the adjoint shading-normal correction ([`Vertex::f_adjoint_cos`]),
+    /// for a camera-subpath vertex f·|ωi·ns|.
+    pub f_cos: SampledSpectrum,
+    /// Area density at the other end of scattering towards it, having come
+    /// from the vertex's own predecessor.
+    pub pdf_fwd: f32,
+    /// Area density at the predecessor of scattering towards it, having
+    /// come from the other end (the adjoint mode).
+    pub pdf_rev: f32,
+}
+
+/// [`JoinEnd`] of surface vertex `v` (BSDF `bsdf`, reached in `v.mode`)
+/// joined along unit direction `w` to a vertex with geometric normal
+/// `other_n` (zero off surfaces) at squared distance `d2`. It reads the
+/// vertex's stored `wo` and [`Vertex::g_prev`] where [`pdf_scatter_pair`]
+/// recomputes both from positions: the same densities up to rounding.
+pub(crate) fn join_end(v: &Vertex, bsdf: &Bsdf, w: Vec3, other_n: Vec3, d2: f32) -> JoinEnd {
+    let pair = bsdf.local_pair(v.wo, w);
+    let f_cos = match v.mode {
+        TransportMode::Importance => match adjoint_cos(&v.it, v.ns, v.wo, w) {
+            Some(k) => bsdf.f_pair(&pair, v.mode) * k,
+            None => SampledSpectrum::zero(),
+        },
+        TransportMode::Radiance => bsdf.f_pair(&pair, v.mode) * w.dot(v.ns).abs(),
+    };
+    let (fwd, rev) = bsdf.pdfs_pair(&pair, v.mode);
+    // [Veach 1997, eq. 8.10], as `to_area` with |d| = 1 for the unit `w`.
+    let cos = if other_n != Vec3::ZERO {
+        other_n.dot(w).abs()
+    } else {
+        1.0
+    };
+    JoinEnd {
+        f_cos,
+        pdf_fwd: fwd.0 * cos / d2,
+        pdf_rev: rev.0 * v.g_prev,
+    }
 }
 
 /// Density of the camera's ray from lens point `cur` through `next`.

@@ -31,7 +31,7 @@
 //! c_s h(p_s) / Σ_k c_k h(p_k), c_k = 1 for every other strategy. Any c
 //! that is a function of the path keeps the weights summing to one.
 
-use super::density::{pdf, pdf_light_origin, pdf_scatter_pair};
+use super::density::{pdf, pdf_light_origin, pdf_scatter_pair, JoinEnd};
 use crate::bsdf::TransportMode;
 use crate::camera::Camera;
 use crate::integrator::nee::{nee_area_density, nee_context};
@@ -74,6 +74,9 @@ pub(crate) struct PathView<'a> {
     pub light_end: Option<Vertex>,
     /// Replaces `cam[t − 1]`.
     pub cam_end: Option<Vertex>,
+    /// The connection's densities when the connection computed them
+    /// ([`JoinDensities::of_ends`]); else [`JoinDensities::of`] does.
+    pub join: Option<JoinDensities>,
 }
 
 impl PathView<'_> {
@@ -146,6 +149,22 @@ impl JoinDensities {
             j.p_light[1] = pdf(scene, camera, x(s), prev, x(s + 1), imp);
         }
         j
+    }
+
+    /// They for a connection of two surface vertices (s, t ≥ 2) whose
+    /// ends were evaluated once for the contribution and the weight
+    /// ([`join_end`]: the light end's, then the camera end's).
+    pub fn of_ends(light: &JoinEnd, cam: &JoinEnd) -> Self {
+        Self {
+            p_light: [light.pdf_fwd, cam.pdf_rev],
+            p_eye: [cam.pdf_fwd, light.pdf_rev],
+        }
+    }
+
+    /// The connection's own ([`PathView::join`]) or computed ones.
+    #[inline]
+    pub fn of_view(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
+        view.join.unwrap_or_else(|| Self::of(scene, camera, view))
     }
 
     /// p_L[i] of `view`: these where the connection determines it, the
@@ -235,7 +254,7 @@ pub(crate) struct PathDensities {
 impl PathDensities {
     /// Gathers the densities of `view`: stored ones and [`JoinDensities`].
     pub fn of(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
-        let j = JoinDensities::of(scene, camera, view);
+        let j = JoinDensities::of_view(scene, camera, view);
         let n = view.n();
         let p_l0 = j.p_light(view, 0);
         Self {
@@ -347,7 +366,7 @@ pub(crate) fn mis_weight(
     c_lt: f32,
 ) -> f32 {
     let (n, s) = (view.n(), view.s);
-    let j = JoinDensities::of(scene, camera, view);
+    let j = JoinDensities::of_view(scene, camera, view);
     let x0 = view.get(0);
     let strategies = Strategies::new(scene, camera, x0, n);
     let valid = |k: usize| strategies.valid(|i| is_delta(view, i), k);

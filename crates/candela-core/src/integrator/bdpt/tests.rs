@@ -334,6 +334,7 @@ fn emitter_views<'a>(rs: &RenderSetup, cam: &'a [Vertex], t: usize) -> Vec<PathV
             t,
             light_end: None,
             cam_end: Some(e),
+            join: None,
         })
         .collect()
 }

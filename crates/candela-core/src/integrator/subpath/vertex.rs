@@ -57,6 +57,12 @@ pub struct Vertex {
     pub pdf_fwd: PdfArea,
     /// Area density from the other subpath.
     pub pdf_rev: PdfArea,
+    /// |cos θ| / d² at the previous vertex of its own subpath, seen from
+    /// this one: what converts a solid-angle density here towards that
+    /// vertex into area there (1 when it is at infinity; 0 when unknown).
+    /// Set by walks with densities; connections read it instead of
+    /// recomputing the distance.
+    pub g_prev: f32,
     /// The lobe sampled here was a delta: no connection can end here.
     pub delta: bool,
     /// Direction light travels from a light at infinity (zero otherwise).
@@ -89,6 +95,7 @@ impl Vertex {
             beta,
             pdf_fwd: PdfArea(0.0),
             pdf_rev: PdfArea(0.0),
+            g_prev: 0.0,
             delta: false,
             w_inf: Vec3::ZERO,
             depth: 0,
