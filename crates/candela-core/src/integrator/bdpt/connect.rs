@@ -13,8 +13,9 @@
 //! f̂_L = f·|ωo·ns||ωi·ng|/|ωo·ng| is the light-side BSDF with the adjoint
 //! shading-normal correction [Veach 1997, eq. 5.19] and its geometric cosine.
 
-use super::density::{emitted, join_end, pdf_light_origin};
+use super::density::{emitted, join_end, pdf, pdf_light_origin};
 use super::mis::{mis_weight, JoinDensities, MisHeuristic, PathView};
+use crate::bsdf::TransportMode;
 use crate::camera::Camera;
 use crate::integrator::lt_weights::LtWeights;
 use crate::integrator::nee::{sample_light, Receiver};
@@ -184,7 +185,9 @@ fn connect_camera<R>(
     if !cx.camera.is_connectable() {
         return None;
     }
-    let f_hat = match v.kind {
+    // The light end's f̂ and, for a surface vertex, its pair densities
+    // (`join_end`; the lens's density of the vertex is the camera's).
+    let (f, cs, end) = match v.kind {
         VertexKind::Light(id) => {
             let l = cx.scene.light(id);
             if l.light_type() != LightType::Area || !l.is_hittable() {
@@ -192,7 +195,7 @@ fn connect_camera<R>(
             }
             let cs = cx.camera.sample_wi(&v.it, u)?;
             let le = emitted(cx.scene, v, cs.wi, cx.lambda) * cs.wi.dot(v.it.n).abs();
-            (le, cs)
+            (le, cs, None)
         }
         _ => {
             let bsdf = v.bsdf.as_ref()?;
@@ -200,10 +203,11 @@ fn connect_camera<R>(
                 return None;
             }
             let cs = cx.camera.sample_wi(&v.it, u)?;
-            (v.f_adjoint_cos(cs.wi), cs)
+            let d2 = (cs.p_lens.p - v.p()).length_squared();
+            let end = join_end(v, bsdf, cs.wi, cs.p_lens.n, d2);
+            (end.f_cos, cs, Some(end))
         }
     };
-    let (f, cs) = f_hat;
     if cs.pdf.0 == 0.0 || f.is_black() {
         return None;
     }
@@ -213,6 +217,10 @@ fn connect_camera<R>(
     }
     let mut lens = Vertex::camera(cs.p_lens, SampledSpectrum::splat(cs.we / cs.pdf.0));
     lens.pdf_fwd = PdfArea(0.0);
+    let join = end.map(|end| {
+        let p_lens = pdf(cx.scene, cx.camera, &lens, None, v, TransportMode::Radiance);
+        JoinDensities::of_lens(&end, p_lens)
+    });
     let view = PathView {
         light,
         cam,
@@ -220,7 +228,7 @@ fn connect_camera<R>(
         t: 1,
         light_end: None,
         cam_end: Some(lens),
-        join: None,
+        join,
     };
     Some(k((c, Some(cs.p_raster)), &view))
 }

@@ -161,6 +161,18 @@ impl JoinDensities {
         }
     }
 
+    /// They for light tracing (t = 1) from surface vertex x_{s−1}, s ≥ 2,
+    /// whose end was evaluated once ([`join_end`]), with `p_lens`, the
+    /// lens's area density of generating x_{s−1}. (p_L[s], the density of
+    /// the lens point, enters no weight, t = 0 being no strategy; it is
+    /// kept so the tests compare every density.)
+    pub fn of_lens(light: &JoinEnd, p_lens: f32) -> Self {
+        Self {
+            p_light: [light.pdf_fwd, 0.0],
+            p_eye: [p_lens, light.pdf_rev],
+        }
+    }
+
     /// The connection's own ([`PathView::join`]) or computed ones.
     #[inline]
     pub fn of_view(scene: &Scene, camera: &Camera, view: &PathView<'_>) -> Self {
