@@ -82,7 +82,7 @@ fn round_away(x: f32, offset: f32) -> f32 {
     } else {
         step
     };
-    let nonzero = offset > 0.0 || offset < 0.0;
+    let nonzero = offset.abs() > 0.0; // false for ±0 and NaN
     f32::from_bits(if nonzero { moved } else { b })
 }
 
