@@ -101,6 +101,11 @@ impl CellHash {
         self.hi = self.hi.max(hi);
     }
 
+    /// Records the occupied cells of `other` (the same grid) too.
+    pub(super) fn merge_occupied(&mut self, other: &CellHash) {
+        self.mark_occupied(other.lo, other.hi);
+    }
+
     /// Inclusive range of cells overlapping the box `p ± r` (padded against
     /// rounding), or `None` for a negative or NaN radius. When r² overflows,
     /// the `≤ r²` test passes at any distance, so every cell is in range.

@@ -88,12 +88,15 @@ impl SppmIntegrator {
         if camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth, out).is_none() {
             return PassOutcome::Cancelled;
         }
-        let out: &Visits = out;
+        let mut grids = std::mem::take(&mut out.grids);
         let radius: Vec<f32> = st.stats.iter().map(|p| p.r2.sqrt() as f32).collect();
         let n = st.photons_per_iteration;
-        let Some(gathered) = photon_pass(ctx, out, &radius, &pw, &s.shoot(), pass, n) else {
+        let gathered = photon_pass(ctx, out, &mut grids, &radius, &pw, &s.shoot(), pass, n);
+        out.grids = grids;
+        let Some(gathered) = gathered else {
             return PassOutcome::Cancelled;
         };
+        let out: &Visits = out;
         let sensor = ctx.film.sensor();
         // Every pixel's update is its own: in parallel (this loop was the
         // largest serial part of an iteration).

@@ -124,6 +124,10 @@ pub struct Visits {
     /// every group ([`VisiblePoint::all_groups`]; its own group's slot stays
     /// empty, that BSDF is [`VisiblePoint::bsdf`]). Empty when G = 1.
     pub group_bsdfs: Vec<Option<Bsdf>>,
+    /// The photon pass's visible-point grids, kept between passes so that
+    /// their entry arrays (tens of MB at a few hundred thousand pixels) are
+    /// reused rather than allocated and faulted in anew every iteration.
+    pub grids: Vec<SphereGrid>,
 }
 
 impl Visits {
@@ -356,15 +360,22 @@ impl Gathered {
 const CHUNK: u64 = 4096;
 
 /// The spheres of the G + 1 grids of a photon pass, each as long as
-/// `visits` (a negative radius where the grid has no point), so a grid's
-/// indices are visit indices: list k < G holds group k's points that gather
-/// only their own group's photons, list G those that gather every group's.
+/// `visits` (a negative radius where the grid has no point; empty when it
+/// has none), so a grid's indices are visit indices: list k < G holds group
+/// k's points that gather only their own group's photons, list G those that
+/// gather every group's.
 fn grid_spheres(visits: &[PixelVisit], radius: &[f32], g: usize) -> Vec<Vec<Sphere>> {
     let none = Sphere(Vec3::ZERO, -1.0);
-    let mut lists: Vec<Vec<Sphere>> = (0..=g).map(|_| vec![none; visits.len()]).collect();
+    // A list is allocated when its first point comes: usually one group
+    // (all points gather every group unless a dispersive surface is seen),
+    // and an empty list builds an empty grid at no cost.
+    let mut lists: Vec<Vec<Sphere>> = vec![Vec::new(); g + 1];
     for (j, (v, &r)) in visits.iter().zip(radius).enumerate() {
         if let Some(vp) = &v.vp {
             let k = if vp.all_groups { g } else { v.group };
+            if lists[k].is_empty() {
+                lists[k] = vec![none; visits.len()];
+            }
             lists[k][j] = Sphere(vp.p, r);
         }
     }
@@ -377,6 +388,7 @@ fn grid_spheres(visits: &[PixelVisit], radius: &[f32], g: usize) -> Vec<Vec<Sphe
 pub fn photon_pass(
     ctx: &RenderContext<'_>,
     out: &Visits,
+    grids: &mut Vec<SphereGrid>,
     radius: &[f32],
     pw: &PassWavelengths,
     shoot: &ShootSettings,
@@ -390,11 +402,14 @@ pub fn photon_pass(
     // photons, one (the last) for those that gather all; their spheres are
     // sorted out in one pass over the visits (240 bytes each: a pass per
     // grid read them G + 1 times), then the grids are built side by side
-    // (each build is serial).
-    let grids: Vec<SphereGrid> = grid_spheres(visits, radius, g)
-        .into_par_iter()
-        .map(|spheres| SphereGrid::build(&spheres))
-        .collect();
+    // (each build is serial) in `grids`' storage.
+    let lists = grid_spheres(visits, radius, g);
+    grids.resize_with(lists.len(), SphereGrid::default);
+    grids
+        .par_iter_mut()
+        .zip(lists.into_par_iter())
+        .for_each(|(grid, spheres)| grid.rebuild(&spheres));
+    let grids: &[SphereGrid] = grids;
     let lists: Vec<Option<Vec<(u32, u32, SampledSpectrum)>>> = (0..n_photons.div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {

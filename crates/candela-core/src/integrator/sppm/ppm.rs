@@ -96,12 +96,17 @@ impl Integrator for PpmIntegrator {
         if camera_pass(ctx, &pixels, pass as u32, &pw, st.max_depth, &mut guard).is_none() {
             return PassOutcome::Cancelled;
         }
-        let out: &Visits = &guard;
+        let mut grids = std::mem::take(&mut guard.grids);
         let r2 = self.radius2(pass);
         let radius = vec![r2.sqrt() as f32; pixels.len()];
-        let Some(gathered) = photon_pass(ctx, out, &radius, &pw, &shoot, pass, n_photons) else {
+        let gathered = photon_pass(
+            ctx, &guard, &mut grids, &radius, &pw, &shoot, pass, n_photons,
+        );
+        guard.grids = grids;
+        let Some(gathered) = gathered else {
             return PassOutcome::Cancelled;
         };
+        let out: &Visits = &guard;
         let norm = (1.0 / (n_photons as f64 * std::f64::consts::PI * r2)) as f32;
         let mut buf = ctx.film.splat_buffer();
         for (j, (pixel, v)) in pixels.iter().zip(&out.visits).enumerate() {
