@@ -14,7 +14,9 @@
 //! ratios pass through them, as in pbrt.
 //!
 //! The densities next to the connection are unknown to either subpath and
-//! are computed here; all others were stored by the random walks.
+//! are computed here ([`JoinDensities::of`]), or by the connection itself
+//! where it evaluates its ends anyway ([`super::density::join_end`], handed
+//! over in [`PathView::join`]); all others were stored by the random walks.
 //!
 //! **Next-event density.** Strategy k = 1 (next-event estimation at x₁)
 //! draws x₀ with the light sampler's own density p_NEE(x₀ | x₁), which for
