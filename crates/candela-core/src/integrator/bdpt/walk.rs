@@ -16,12 +16,14 @@ use crate::bsdf::TransportMode;
 use crate::camera::Camera;
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
-    start_light_subpath, walk, Dispersion, Escape, Flow, Scatter, Start, Vertex, Visitor, Walk,
+    start_light_subpath, to_area_at, walk, Dispersion, EndPoint, Escape, Flow, Scatter, Start,
+    Vertex, Visitor, Walk,
 };
 use crate::interaction::Interaction;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Ray;
 use crate::sampler::Sampler;
+use crate::sampling::PdfSolidAngle;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -64,7 +66,14 @@ impl Visitor<Sampler> for Store<'_> {
         _: &mut SampledWavelengths,
         _: &mut Sampler,
     ) -> Flow {
-        self.path.push(*v);
+        // The previous vertex stored is the walk's previous vertex (the
+        // subpath's endpoint for the first): its area factor, for the
+        // connections' reverse densities ([`Vertex::g_prev`]).
+        let mut v = *v;
+        if let Some(prev) = self.path.last() {
+            v.g_prev = to_area_at(PdfSolidAngle(1.0), v.p(), &EndPoint::of(prev)).0;
+        }
+        self.path.push(v);
         Flow::Continue
     }
 

@@ -402,7 +402,7 @@ pub fn photon_pass(
     // photons, one (the last) for those that gather all; their spheres are
     // sorted out in one pass over the visits (240 bytes each: a pass per
     // grid read them G + 1 times), then the grids are built side by side
-    // (each build is serial) in `grids`' storage.
+    // (each in parallel parts itself) in `grids`' storage.
     let lists = grid_spheres(visits, radius, g);
     grids.resize_with(lists.len(), SphereGrid::default);
     grids

@@ -247,9 +247,6 @@ where
                 Some(p) => to_area_at(st.pdf_dir, p.p, &EndPoint::of(&v)),
                 None => PdfArea(0.0),
             };
-            if let Some(p) = &st.prev {
-                v.g_prev = to_area_at(PdfSolidAngle(1.0), v.p(), p).0;
-            }
         }
         let flow = visitor.vertex(&v, &si, lambda, rng);
         if flow == Flow::Stop || st.depth >= w.max_depth {

@@ -60,7 +60,7 @@ pub struct Vertex {
     /// |cos θ| / d² at the previous vertex of its own subpath, seen from
     /// this one: what converts a solid-angle density here towards that
     /// vertex into area there (1 when it is at infinity; 0 when unknown).
-    /// Set by walks with densities; connections read it instead of
+    /// Set by BDPT's subpath store; connections read it instead of
     /// recomputing the distance.
     pub g_prev: f32,
     /// The lobe sampled here was a delta: no connection can end here.
