@@ -12,8 +12,10 @@
 //! take a prefix sum to get each bucket's start, then scatter the points
 //! into one array ordered by bucket. There is no list or `Vec` per cell,
 //! just `cell_starts` (B + 1 offsets) and the sorted entries. Unlike SmallVCM,
-//! the positions are copied next to the indices, so a query reads one
-//! contiguous run per bucket instead of gathering from the caller's array.
+//! the positions are copied next to the indices, coordinate by coordinate
+//! ([`SoaPoints`]), so a query reads one contiguous run per bucket instead
+//! of gathering from the caller's array, and tests eight distances at a
+//! time.
 //!
 //! **Query.** With `cell_size = 2r` the ball of radius r around p overlaps at
 //! most 2×2×2 cells, the "8 cells around p" of SmallVCM's `Process`. Here
@@ -27,6 +29,7 @@
 //! mapping stays monotone, so distant points are merely crowded into the
 //! border cells, never lost.
 
+use super::soa_points::SoaPoints;
 use super::HasPosition;
 use crate::math::Bounds3;
 use glam::{IVec3, Vec3};
@@ -204,7 +207,7 @@ pub struct HashGrid {
     /// Bucket b owns entries `cell_starts[b]..cell_starts[b + 1]`.
     cell_starts: Vec<u32>,
     /// Positions ordered by bucket.
-    points: Vec<Vec3>,
+    points: SoaPoints,
     /// The caller's index of each entry of `points`.
     indices: Vec<u32>,
 }
@@ -242,12 +245,12 @@ impl HashGrid {
             .collect();
         let cell_starts = prefix_starts(&counts);
         let mut next = cell_starts.clone();
-        let mut points = vec![Vec3::ZERO; items.len()];
+        let mut points = SoaPoints::zeros(items.len());
         let mut indices = vec![0u32; items.len()];
         for (i, (it, &b)) in items.iter().zip(&buckets).enumerate() {
             let slot = next[b as usize] as usize;
             next[b as usize] += 1;
-            points[slot] = it.position();
+            points.set(slot, it.position());
             indices[slot] = i as u32;
         }
         Self {
@@ -271,14 +274,25 @@ impl HashGrid {
     /// Calls `f(index, dist²)` once for every point within `radius` of `p`
     /// (inclusive); `index` is the point's position in the build slice.
     pub fn for_each_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(u32, f32)) {
+        self.for_each_slot_within(p, radius, |slot| {
+            f(
+                self.indices[slot],
+                (self.points.get(slot) - p).length_squared(),
+            )
+        });
+    }
+
+    /// Calls `f(slot)` once for every point within `radius` of `p`
+    /// (inclusive), with its entry slot: the point's position in
+    /// [`Self::entry_order`]. For a caller that keeps its records in entry
+    /// order and reads one only when its point is found, the distances
+    /// being tested here on the grid's own packed positions (module doc of
+    /// `soa_points`).
+    #[inline]
+    pub fn for_each_slot_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(usize)) {
         let r2 = radius * radius;
         self.for_each_candidate_run(p, radius, |run| {
-            for (q, &i) in self.points[run.clone()].iter().zip(&self.indices[run]) {
-                let d2 = (*q - p).length_squared();
-                if d2 <= r2 {
-                    f(i, d2);
-                }
-            }
+            self.points.for_each_within(run, p, r2, &mut f)
         });
     }
 

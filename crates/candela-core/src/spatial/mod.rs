@@ -28,6 +28,7 @@
 
 mod hash_grid;
 mod kdtree;
+mod soa_points;
 mod sphere_grid;
 #[cfg(test)]
 mod tests;

@@ -480,7 +480,8 @@ impl CameraVisitor<'_, '_> {
         let max_depth = self.vcm.settings.max_depth;
         let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
         // Light vertices next to the light merge here only where that merge
-        // exists ([`Factors::merges_at`]); the rest always do.
+        // exists ([`Factors::merges_at`]); the rest always do. The grid
+        // hands out the former only when asked to.
         let merge_direct = f.merges_at(true, self.arrived_delta);
         let r2 = self.cp.radius * self.cp.radius;
         let x = Surfel {
@@ -499,8 +500,8 @@ impl CameraVisitor<'_, '_> {
                 ph.depth + v.depth > max_depth + 1
             }
         };
-        grid.for_each_within(v.p(), self.cp.radius, |ph| {
-            if too_deep(ph) || (ph.depth == 1 && !merge_direct) {
+        grid.for_each_within(v.p(), self.cp.radius, merge_direct, |ph| {
+            if too_deep(ph) {
                 return;
             }
             let k = v.depth + ph.depth - 1;

@@ -57,7 +57,7 @@ impl VcmIntegrator {
             });
         }
         let grid = (t.merge && !light.is_empty() && radius > 0.0)
-            .then(|| MergeGrid::build(&light, radius));
+            .then(|| MergeGrid::build(&light, radius, f.merges_at(true, true)));
         let cp = CameraPass {
             light: &light,
             grid: grid.as_ref(),

@@ -1,19 +1,33 @@
 //! The merge side of an iteration: the light vertices as photons, in the
-//! order of the hash grid that finds them.
+//! order of the hash grids that find them.
 //!
 //! A merge reads, for every light vertex within r of a camera vertex, only
 //! its position, geometric normal, `wo`, β, depth, dispersion flag and the
 //! vertex's partial MIS quantities ([`Partial::merge_weight`]): 72 bytes,
 //! against the 232 of a whole [`LightVertex`] with its BSDF. The photons are
 //! made from the light pass's chunks and copied once per iteration into the
-//! grid's entry order ([`HashGrid::entry_order`]), both in parallel (only
-//! the grid's counting sort runs on one thread), so the photons of one bucket are adjacent in
-//! memory, and a query reads them front to back, positions included
-//! ([`HashGrid::for_each_candidate_run`]): one cache miss per bucket.
-//! Reading the stored vertices through the grid's indices instead was a
-//! cache miss per point found:
-//! on the Cornell box at 128² that load alone was 18 % of a VCM iteration
-//! (`perf annotate`, the merge loop was 39 % of it).
+//! grid's entry order ([`HashGrid::entry_order`]), in parallel (only the
+//! grid's counting sort runs on one thread), so the photons of one bucket
+//! are adjacent in memory. A query tests the distances on the grid's own
+//! packed positions, eight at a time ([`HashGrid::for_each_slot_within`]),
+//! and reads a photon only when it is within r: with cells of side 2r a
+//! query on the Cornell box tests about six candidates for each photon it
+//! finds. Reading the stored vertices through the grid's indices instead
+//! was a cache miss per point found: on the Cornell box at 128² that load
+//! alone was 18 % of a VCM iteration (`perf annotate`, the merge loop was
+//! 39 % of it).
+//!
+//! **Two grids.** The vertices next to the light (the first of each light
+//! subpath) merge only where a merge next to the light is a technique
+//! ([`super::mis::Factors::merges_at`]): by default only after a specular
+//! camera vertex. They are a third of the stored vertices on the Cornell
+//! box and were a quarter of the photons its queries found, each found to
+//! be dropped. So they have a grid of their own, queried only where they
+//! merge, and built only when they can merge at all (`directmerges` not
+//! `never`). Measured (callgrind, Cornell box at 128², 12 iterations, one
+//! thread): 9.744 G instructions with one grid, 9.552 G with two, 9.382 G
+//! with the packed distance test as well; wall time 3.66–3.67 s against
+//! 3.49–3.55 s at 40 iterations (five interleaved runs each).
 
 use super::light::{LightPaths, LightVertex};
 use super::mis::Partial;
@@ -65,60 +79,69 @@ impl HasPosition for Photon {
     }
 }
 
-/// A hash grid over an iteration's light vertices and their photons in the
-/// grid's entry order.
-pub(super) struct MergeGrid {
+/// A hash grid over some of an iteration's light vertices and their photons
+/// in the grid's entry order.
+struct Part {
     grid: HashGrid,
     photons: Vec<Photon>,
 }
 
-impl MergeGrid {
-    /// The grid for merge radius `radius` over the stored vertices of `light`.
+impl Part {
+    /// The part over the stored vertices of `light` that `keep` selects.
     /// The grid is built over their positions alone (12 bytes a vertex,
     /// gathered on one thread), and each photon is made once, in parallel,
-    /// straight into its entry slot: collecting the photons first through
-    /// rayon's `flat_map_iter` and then reordering them cost 2.3 + 1.2 ms
-    /// of a 65-ms Cornell box iteration at 128² on 2 threads, against
-    /// 0.7 ms for the grid itself.
-    pub fn build(light: &LightPaths, radius: f32) -> Self {
-        let chunks = light.chunks();
-        let positions: Vec<Vec3> = chunks
-            .iter()
-            .flat_map(|c| c.iter().map(|v| v.it.p))
+    /// straight into its entry slot.
+    fn build(light: &LightPaths, radius: f32, keep: impl Fn(&LightVertex) -> bool) -> Self {
+        let kept: Vec<&LightVertex> = light
+            .chunks()
+            .into_iter()
+            .flat_map(|c| c.iter().filter(|v| keep(v)))
             .collect();
+        let positions: Vec<Vec3> = kept.iter().map(|v| v.it.p).collect();
         let grid = HashGrid::build(&positions, radius);
-        // First global index of each chunk, to find an entry's vertex.
-        let starts: Vec<usize> = chunks
-            .iter()
-            .scan(0, |n, c| {
-                let s = *n;
-                *n += c.len();
-                Some(s)
-            })
-            .collect();
-        let vertex = |i: u32| {
-            let i = i as usize;
-            let c = starts.partition_point(|&s| s <= i) - 1;
-            &chunks[c][i - starts[c]]
-        };
         let photons = grid
             .entry_order()
             .par_iter()
-            .map(|&i| Photon::new(vertex(i)))
+            .map(|&i| Photon::new(kept[i as usize]))
             .collect();
-        MergeGrid { grid, photons }
+        Part { grid, photons }
     }
 
-    /// Calls `f` with every photon within `radius` of `p` (inclusive).
+    /// Calls `f` with every photon of the part within `radius` of `p`.
     #[inline]
-    pub fn for_each_within(&self, p: Vec3, radius: f32, mut f: impl FnMut(&Photon)) {
-        let r2 = radius * radius;
-        self.grid.for_each_candidate_run(p, radius, |run| {
-            for ph in &self.photons[run] {
-                if (ph.surfel.p - p).length_squared() <= r2 {
-                    f(ph);
-                }
-            }
-        });
+    fn for_each_within(&self, p: Vec3, radius: f32, f: &mut impl FnMut(&Photon)) {
+        self.grid
+            .for_each_slot_within(p, radius, |slot| f(&self.photons[slot]));
+    }
+}
+
+/// Hash grids over an iteration's light vertices, those next to the light
+/// apart from the rest (module doc).
+pub(super) struct MergeGrid {
+    /// The vertices next to the light, when they can merge anywhere.
+    direct: Option<Part>,
+    /// The other vertices.
+    beyond: Part,
+}
+
+impl MergeGrid {
+    /// The grids for merge radius `radius` over the stored vertices of
+    /// `light`; the vertices next to the light only when `direct` (they can
+    /// merge somewhere).
+    pub fn build(light: &LightPaths, radius: f32, direct: bool) -> Self {
+        MergeGrid {
+            direct: direct.then(|| Part::build(light, radius, |v| v.depth == 1)),
+            beyond: Part::build(light, radius, |v| v.depth != 1),
+        }
+    }
+
+    /// Calls `f` with every photon within `radius` of `p` (inclusive), those
+    /// next to the light only when `direct`.
+    #[inline]
+    pub fn for_each_within(&self, p: Vec3, radius: f32, direct: bool, mut f: impl FnMut(&Photon)) {
+        if let Some(d) = self.direct.as_ref().filter(|_| direct) {
+            d.for_each_within(p, radius, &mut f);
+        }
+        self.beyond.for_each_within(p, radius, &mut f);
     }
 }
