@@ -397,6 +397,15 @@ impl Bsdf {
             wi: self.to_local(wi_render),
         }
     }
+    /// [`Self::local_pair`] with `wo` already local ([`Self::to_local`],
+    /// made once for the many `wi` of a merge or of the joins at one vertex).
+    #[inline]
+    pub fn local_pair_from(&self, wo_local: Vec3, wi_render: Vec3) -> LocalPair {
+        LocalPair {
+            wo: wo_local,
+            wi: self.to_local(wi_render),
+        }
+    }
     /// [`Self::f`] of the pair.
     #[inline]
     pub fn f_pair(&self, d: &LocalPair, mode: TransportMode) -> SampledSpectrum {

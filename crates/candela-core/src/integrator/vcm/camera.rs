@@ -39,7 +39,7 @@ use crate::integrator::RenderContext;
 use crate::interaction::Interaction;
 use crate::interaction::SurfaceInteraction;
 use crate::light::LightSampleContext;
-use crate::math::UVec2;
+use crate::math::{UVec2, Vec3};
 use crate::sampler::Sampler;
 use crate::sampling::PathRng;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -399,12 +399,13 @@ impl CameraVisitor<'_, '_> {
         let max_depth = self.vcm.settings.max_depth;
         let tau = self.vcm.settings.join_roulette;
         let path = self.path;
+        let wo_local = cb.to_local(v.wo);
         let joinable = path.iter().take_while(|lv| lv.depth + v.depth <= max_depth);
         let scene = self.ctx.scene;
         match self.vcm.settings.connections {
             Connections::All => {
                 for lv in joinable {
-                    let Some((x, w)) = self.connection(v, cb, lv, terminated) else {
+                    let Some((x, w)) = self.connection(v, cb, wo_local, lv, terminated) else {
                         continue;
                     };
                     let Some(kept) = thin(w, tau, || rng.u1()) else {
@@ -418,7 +419,7 @@ impl CameraVisitor<'_, '_> {
             Connections::One => {
                 let mut r = Resampler::new(rng.u1());
                 for lv in joinable {
-                    if let Some((x, w)) = self.connection(v, cb, lv, terminated) {
+                    if let Some((x, w)) = self.connection(v, cb, wo_local, lv, terminated) {
                         r.offer((lv, x, w), x.average());
                     }
                 }
@@ -435,13 +436,14 @@ impl CameraVisitor<'_, '_> {
         }
     }
 
-    /// The MIS-weighted contribution of joining `v` to light vertex `lv`
-    /// if nothing lies between them [eqs. 40–41], and its weight; `None`
-    /// when it is zero.
+    /// The MIS-weighted contribution of joining `v` (its `wo` in `cb`'s
+    /// frame: `wo_local`) to light vertex `lv` if nothing lies between them
+    /// [eqs. 40–41], and its weight; `None` when it is zero.
     fn connection(
         &self,
         v: &Vertex,
         cb: &Bsdf,
+        wo_local: Vec3,
         lv: &LightVertex,
         terminated: bool,
     ) -> Option<(SampledSpectrum, f32)> {
@@ -451,7 +453,7 @@ impl CameraVisitor<'_, '_> {
             return None;
         }
         let w = d / d2.sqrt();
-        let cam = cb.local_pair(v.wo, w);
+        let cam = cb.local_pair_from(wo_local, w);
         let f_cam = cb.f_pair(&cam, TransportMode::Radiance) * w.dot(v.ns).abs();
         let (f_light, light) = lv.f_adjoint_cos(-w);
         let c = v.beta * f_cam * f_light * lv.beta / d2;
@@ -489,6 +491,7 @@ impl CameraVisitor<'_, '_> {
             n: v.it.n,
             w: v.wo,
         };
+        let wo_local = cb.to_local(v.wo);
         let mut sum = SampledSpectrum::zero();
         let mut by_length: ByLength = [0.0; LENGTHS + 1];
         // The whole path has at most maxdepth scattering vertices; in mode
@@ -508,7 +511,7 @@ impl CameraVisitor<'_, '_> {
             let Some(c) = gather(&x, &ph.surfel, r2) else {
                 return;
             };
-            let pair = cb.local_pair(v.wo, c.wi);
+            let pair = cb.local_pair_from(wo_local, c.wi);
             let fv = cb.f_pair(&pair, TransportMode::Radiance);
             if fv.is_black() {
                 return;

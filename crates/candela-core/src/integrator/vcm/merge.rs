@@ -87,18 +87,12 @@ struct Part {
 }
 
 impl Part {
-    /// The part over the stored vertices of `light` that `keep` selects.
-    /// The grid is built over their positions alone (12 bytes a vertex,
-    /// gathered on one thread), and each photon is made once, in parallel,
-    /// straight into its entry slot.
-    fn build(light: &LightPaths, radius: f32, keep: impl Fn(&LightVertex) -> bool) -> Self {
-        let kept: Vec<&LightVertex> = light
-            .chunks()
-            .into_iter()
-            .flat_map(|c| c.iter().filter(|v| keep(v)))
-            .collect();
-        let positions: Vec<Vec3> = kept.iter().map(|v| v.it.p).collect();
-        let grid = HashGrid::build(&positions, radius);
+    /// The part over `kept` (stored vertices) at `positions` (theirs). The
+    /// grid is built over the positions alone (12 bytes a vertex, on one
+    /// thread), and each photon is made once, in parallel, straight into
+    /// its entry slot.
+    fn build(kept: &[&LightVertex], positions: &[Vec3], radius: f32) -> Self {
+        let grid = HashGrid::build(positions, radius);
         let photons = grid
             .entry_order()
             .par_iter()
@@ -129,10 +123,21 @@ impl MergeGrid {
     /// `light`; the vertices next to the light only when `direct` (they can
     /// merge somewhere).
     pub fn build(light: &LightPaths, radius: f32, direct: bool) -> Self {
-        MergeGrid {
-            direct: direct.then(|| Part::build(light, radius, |v| v.depth == 1)),
-            beyond: Part::build(light, radius, |v| v.depth != 1),
+        // One pass over the stored vertices (256 bytes each) sorts them.
+        let mut parts: [(Vec<&LightVertex>, Vec<Vec3>); 2] = Default::default();
+        for v in light.chunks().into_iter().flatten() {
+            if v.depth != 1 || direct {
+                let (kept, positions) = &mut parts[usize::from(v.depth == 1)];
+                kept.push(v);
+                positions.push(v.it.p);
+            }
         }
+        let [(beyond, beyond_p), (near, near_p)] = &parts;
+        let (direct, beyond) = rayon::join(
+            || direct.then(|| Part::build(near, near_p, radius)),
+            || Part::build(beyond, beyond_p, radius),
+        );
+        MergeGrid { direct, beyond }
     }
 
     /// Calls `f` with every photon within `radius` of `p` (inclusive), those
