@@ -163,30 +163,38 @@ Material "conductor" "texture eta" "c" "texture k" "c" "float roughness" [0.3]"#
 /// for trilinear). Over 256 pixels a variance is known to ±9% (√(2/255)), so
 /// without aliasing a ratio of variances is 1 ± 0.13; staying below 1.8 is a
 /// 6σ margin, and level-0 lookups (ratio ≈ 3) fail it.
-#[test]
-fn minified_checkerboard_is_averaged_by_every_filter() {
-    let dir = temp_dir("mip");
+/// The mean and standard deviation over the pixels of `world` rendered
+/// over the 64×64 checkerboard of [`minified_checkerboard_is_averaged_by_every_filter`].
+fn checkerboard_spread(dir: &Path, world: &str) -> (f64, f64) {
     let n = 64u32;
     let img = image::GrayImage::from_fn(n, n, |x, y| {
         image::Luma([if (x + y) % 2 == 0 { 255 } else { 0 }])
     });
     img.save(dir.join("checks.png")).unwrap();
-    let spread = |filter: &str| {
-        let (img, warnings) = render(
-            &dir,
-            &format!(
-                r#"Texture "c" "spectrum" "imagemap" "string filename" "checks.png" "string filter" "{filter}"
+    let (img, warnings) = render(dir, world, 16);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let v: Vec<f64> = img.pixels.iter().map(|p| p[1] as f64).collect();
+    assert!(v.iter().all(|x| x.is_finite()));
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt();
+    (mean, sd)
+}
+
+/// The checkerboard texture with MIP filter `filter`.
+fn checks(filter: &str) -> String {
+    format!(
+        r#"Texture "c" "spectrum" "imagemap" "string filename" "checks.png" "string filter" "{filter}"
     "string encoding" "linear" "float uscale" [8] "float vscale" [8]
-Material "diffuse" "texture reflectance" "c""#
-            ),
-            16,
-        );
-        assert!(warnings.is_empty(), "{warnings:?}");
-        let v: Vec<f64> = img.pixels.iter().map(|p| p[1] as f64).collect();
-        assert!(v.iter().all(|x| x.is_finite()));
-        let mean = v.iter().sum::<f64>() / v.len() as f64;
-        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt();
-        (mean, sd)
+"#
+    )
+}
+
+#[test]
+fn minified_checkerboard_is_averaged_by_every_filter() {
+    let dir = temp_dir("mip");
+    let spread = |filter: &str| {
+        let world = checks(filter) + r#"Material "diffuse" "texture reflectance" "c""#;
+        checkerboard_spread(&dir, &world)
     };
     let (_, tri_sd) = spread("trilinear");
     for filter in ["trilinear", "ewa", "bilinear", "point"] {
@@ -204,5 +212,27 @@ Material "diffuse" "texture reflectance" "c""#
             "{filter} aliases: variance ratio {ratio} ({sd} vs trilinear {tri_sd})"
         );
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A mix material whose own parameters name no texture (a constant amount
+/// of 0 picks its first material) gives its hits the footprint that its
+/// textured material filters with: the checkerboard seen through the mix
+/// is as smooth as seen directly (the variance ratio bound of
+/// [`minified_checkerboard_is_averaged_by_every_filter`]; without the
+/// footprint the lookups read level 0 and alias, ratio ≈ 3).
+#[test]
+fn a_mix_passes_the_footprint_to_its_textured_material() {
+    let dir = temp_dir("mipmix");
+    let direct = checks("trilinear") + r#"Material "diffuse" "texture reflectance" "c""#;
+    let mixed = checks("trilinear")
+        + r#"MakeNamedMaterial "textured" "string type" "diffuse" "texture reflectance" "c"
+MakeNamedMaterial "plain" "string type" "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+MakeNamedMaterial "both" "string type" "mix" "string materials" ["textured" "plain"] "float amount" [0]
+NamedMaterial "both""#;
+    let (_, direct_sd) = checkerboard_spread(&dir, &direct);
+    let (_, mixed_sd) = checkerboard_spread(&dir, &mixed);
+    let ratio = (mixed_sd / direct_sd).powi(2);
+    assert!(ratio < 1.8, "the mix aliases: variance ratio {ratio}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -22,10 +22,25 @@ use std::collections::HashMap;
 pub type MaterialNames = (HashMap<String, MaterialId>, MaterialId);
 
 /// All materials, the name table, and which `Texture` directives they used.
+/// The scene's materials, their names, which `Texture` directives they
+/// use, and which materials read a texture (so that their hits need the
+/// camera footprint's differentials).
+pub struct BuiltMaterials {
+    /// Every material, by [`MaterialId`]; the default one last.
+    pub materials: Vec<Material>,
+    /// Named materials and the default.
+    pub names: MaterialNames,
+    /// Per `Texture` directive: used by some material.
+    pub textures_used: Vec<bool>,
+    /// Per material: it reads a texture (a mix: its amount or any material
+    /// it can become), so a hit on it needs its screen-space differentials.
+    pub reads_textures: Vec<bool>,
+}
+
 pub fn materials(
     desc: &SceneDescription,
     warnings: &mut Vec<String>,
-) -> Result<(Vec<Material>, MaterialNames, Vec<bool>), BuildError> {
+) -> Result<BuiltMaterials, BuildError> {
     let first_named = desc.materials.len();
     let names: HashMap<String, MaterialId> = desc
         .named_materials
@@ -40,8 +55,11 @@ pub fn materials(
         .collect();
     let mut textures = Textures::new(&desc.textures);
     let mut out = Vec::with_capacity(all.len() + 1);
+    let mut reads_textures = Vec::with_capacity(all.len() + 1);
     for m in &all {
+        let before = textures.lookups();
         out.push(material(m, &mut textures, &names)?);
+        reads_textures.push(textures.lookups() != before);
     }
     check_mix_cycles(&out, &all)?;
     // pbrt-v4's default material: diffuse, reflectance 0.5.
@@ -50,9 +68,39 @@ pub fn materials(
         reflectance: SpectrumTexture::Constant(Spectrum::Constant(0.5)),
         bump: None,
     });
+    reads_textures.push(false);
+    mixes_read_their_materials(&out, &mut reads_textures);
     let used = textures.used().to_vec();
     warnings.extend_from_slice(textures.warnings());
-    Ok((out, (names, default), used))
+    Ok(BuiltMaterials {
+        materials: out,
+        names: (names, default),
+        textures_used: used,
+        reads_textures,
+    })
+}
+
+/// A mix reads the textures of every material it can become (it is
+/// resolved after the differentials are set). Mixes form no cycle
+/// (`check_mix_cycles`), so as many rounds as materials settle it.
+fn mixes_read_their_materials(materials: &[Material], reads: &mut [bool]) {
+    for _ in 0..materials.len() {
+        let mut changed = false;
+        for (i, m) in materials.iter().enumerate() {
+            if let Material::Mix {
+                materials: parts, ..
+            } = m
+            {
+                if !reads[i] && parts.iter().any(|p| reads[p.0 as usize]) {
+                    reads[i] = true;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            return;
+        }
+    }
 }
 
 /// Roughness: `uroughness`/`vroughness`, each defaulting to `roughness` (0).

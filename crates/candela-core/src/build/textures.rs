@@ -69,6 +69,9 @@ pub struct Textures<'a> {
     floats: HashMap<usize, FloatTexture>,
     spectra: HashMap<(usize, SpectrumKind), SpectrumTexture>,
     used: Vec<bool>,
+    /// Texture lookups so far (cached ones included): a material whose
+    /// building made none reads no texture.
+    lookups: usize,
     images: ImageCache,
 }
 
@@ -95,6 +98,7 @@ impl<'a> Textures<'a> {
             floats: HashMap::new(),
             spectra: HashMap::new(),
             used: vec![false; descs.len()],
+            lookups: 0,
             images: ImageCache::default(),
         }
     }
@@ -111,6 +115,12 @@ impl<'a> Textures<'a> {
         loc: &candela_scene::Loc,
     ) -> Result<Arc<crate::image::MapImage>, BuildError> {
         self.images.normal_map(path, loc)
+    }
+
+    /// Lookups of `Texture` directives so far (by a material's parameters
+    /// or another texture's, cached or not).
+    pub fn lookups(&self) -> usize {
+        self.lookups
     }
 
     /// Which textures were referenced (directly or through other textures).
@@ -222,6 +232,7 @@ impl<'a> Textures<'a> {
 
     /// The float texture declared at index `i`.
     fn build_float(&mut self, i: usize) -> Result<FloatTexture, BuildError> {
+        self.lookups += 1;
         if let Some(t) = self.floats.get(&i) {
             return Ok(t.clone());
         }
@@ -291,6 +302,7 @@ impl<'a> Textures<'a> {
         i: usize,
         kind: SpectrumKind,
     ) -> Result<SpectrumTexture, BuildError> {
+        self.lookups += 1;
         if let Some(t) = self.spectra.get(&(i, kind)) {
             return Ok(t.clone());
         }

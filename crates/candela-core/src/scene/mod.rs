@@ -12,7 +12,7 @@ pub use primitive::Primitive;
 use crate::accel::{Bvh, BvhHit};
 use crate::bsdf::Bsdf;
 use crate::camera::PixelFootprint;
-use crate::interaction::{Interaction, LightId, SurfaceInteraction};
+use crate::interaction::{Interaction, LightId, MaterialId, SurfaceInteraction};
 use crate::light::{Light, LightSampler, LightSelection, NeeLightSampler};
 use crate::material::{mix_choice, Material};
 use crate::math::{Bounds3, Ray, SHADOW_EPSILON};
@@ -41,6 +41,8 @@ pub struct Scene {
     /// The camera's pixel footprint, for texture filtering (none: zero
     /// differentials).
     footprint: Option<PixelFootprint>,
+    /// Per material: a hit on it needs the footprint (it reads a texture).
+    footprint_materials: Vec<bool>,
 }
 
 impl Scene {
@@ -97,13 +99,16 @@ impl Scene {
             nee_sampler,
             bounds,
             footprint: None,
+            footprint_materials: Vec::new(),
         }
     }
 
     /// Sets the camera footprint that gives hits their screen-space
-    /// differentials in [`Scene::bsdf`].
-    pub fn set_footprint(&mut self, footprint: Option<PixelFootprint>) {
+    /// differentials in [`Scene::bsdf`], for hits on the materials that
+    /// `materials` flags (by [`MaterialId`]; those that read a texture).
+    pub fn set_footprint(&mut self, footprint: Option<PixelFootprint>, materials: Vec<bool>) {
         self.footprint = footprint;
+        self.footprint_materials = materials;
     }
     /// The camera footprint, if set.
     pub fn footprint(&self) -> Option<&PixelFootprint> {
@@ -250,7 +255,10 @@ impl Scene {
         lambda: &mut SampledWavelengths,
     ) -> Option<Bsdf> {
         if let Some(f) = &self.footprint {
-            f.set_differentials(si);
+            let reads = |m: MaterialId| self.footprint_materials.get(m.0 as usize) != Some(&false);
+            if si.material.is_some_and(reads) {
+                f.set_differentials(si);
+            }
         }
         let m = self.resolve_material(si)?;
         if let Some(b) = m.bump() {
