@@ -21,7 +21,6 @@ use std::collections::HashMap;
 /// Named material → id, and the default material's id.
 pub type MaterialNames = (HashMap<String, MaterialId>, MaterialId);
 
-/// All materials, the name table, and which `Texture` directives they used.
 /// The scene's materials, their names, which `Texture` directives they
 /// use, and which materials read a texture (so that their hits need the
 /// camera footprint's differentials).
@@ -37,6 +36,8 @@ pub struct BuiltMaterials {
     pub reads_textures: Vec<bool>,
 }
 
+/// All materials, the name table, and which `Texture` directives and
+/// materials read textures.
 pub fn materials(
     desc: &SceneDescription,
     warnings: &mut Vec<String>,

@@ -90,7 +90,10 @@ impl Part {
     /// The part over `kept` (stored vertices) at `positions` (theirs). The
     /// grid is built over the positions alone (12 bytes a vertex, on one
     /// thread), and each photon is made once, in parallel, straight into
-    /// its entry slot.
+    /// its entry slot: collecting the photons first through rayon's
+    /// `flat_map_iter` and then reordering them cost 2.3 + 1.2 ms of a
+    /// 65-ms Cornell box iteration at 128² on 2 threads, against 0.7 ms for
+    /// the grid itself.
     fn build(kept: &[&LightVertex], positions: &[Vec3], radius: f32) -> Self {
         let grid = HashGrid::build(positions, radius);
         let photons = grid
