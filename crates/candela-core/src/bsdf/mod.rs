@@ -392,10 +392,7 @@ impl Bsdf {
     /// `wo` and `wi` (world space) in the local frame.
     #[inline]
     pub fn local_pair(&self, wo_render: Vec3, wi_render: Vec3) -> LocalPair {
-        LocalPair {
-            wo: self.to_local(wo_render),
-            wi: self.to_local(wi_render),
-        }
+        self.local_pair_from(self.to_local(wo_render), wi_render)
     }
     /// [`Self::local_pair`] with `wo` already local ([`Self::to_local`],
     /// made once for the many `wi` of a merge or of the joins at one vertex).

@@ -299,19 +299,16 @@ impl HashGrid {
     /// The build-slice index of every entry, in entry (bucket) order: a
     /// caller that copies its items in this order into an array of its own
     /// reads that array front to back within each bucket when it looks
-    /// them up by the entry slots of [`Self::for_each_candidate_run`],
+    /// them up by the entry slots of [`Self::for_each_slot_within`],
     /// instead of jumping through the build slice (a cache miss per point).
     pub fn entry_order(&self) -> &[u32] {
         &self.indices
     }
 
     /// Calls `f` with the entry slots of every bucket that may hold points
-    /// within `radius` of `p`, each bucket once; the caller tests the
-    /// distances, as `(q − p)·(q − p) ≤ radius²` to find exactly the points
-    /// of [`Self::for_each_within`]. For a caller that keeps the positions
-    /// in its own entry-ordered records, so a bucket costs one cache miss
-    /// instead of two.
-    pub fn for_each_candidate_run(
+    /// within `radius` of `p`, each bucket once: the runs whose distances
+    /// [`Self::for_each_slot_within`] tests.
+    pub(super) fn for_each_candidate_run(
         &self,
         p: Vec3,
         radius: f32,

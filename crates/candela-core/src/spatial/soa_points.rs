@@ -23,7 +23,7 @@ use wide::{f32x8, CmpLe};
 pub const LANES: usize = 8;
 
 /// Points as three coordinate arrays, each padded by [`LANES`] zeros.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct SoaPoints {
     x: Vec<f32>,
     y: Vec<f32>,
