@@ -500,6 +500,7 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
             VcmSettings::default().join_roulette,
             Domain::Closed(0.0, 1.0),
         )?,
+        split_specular: ck.params.get_bool("splitspecular", true)?,
     })
 }
 

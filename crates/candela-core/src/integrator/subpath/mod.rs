@@ -31,6 +31,24 @@
 //! at a scattering, the record's densities and cosine. Other visitors skip
 //! the reverse BSDF evaluation.
 //!
+//! **Splitting.** A visitor may fork the walk at a vertex whose BSDF is a
+//! pair of delta lobes, a reflection and a transmission (a smooth
+//! dielectric): [`Visitor::fork`] gives a copy of it with nothing
+//! accumulated, which walks the reflection alone (density 1, so its β takes
+//! the Fresnel factor F instead of a choice made with probability F), while
+//! the walk itself goes on choosing between the lobes as always;
+//! [`Visitor::join`] then adds what the copy found. The two walks see the
+//! same paths through the reflection, so the visitor must divide them: each
+//! counts a disjoint part, the copy's weighted by F, the walk's by 1 / F
+//! when it took the reflection [the splitting of Arvo and Kirk 1990,
+//! "Particle transport and image synthesis", §4]. What for: a bright light
+//! seen in that reflection is then found on every sample through the pixels
+//! it lights, at F times its radiance, instead of on one sample in 1 / F at
+//! full radiance. The densities a visitor is told are a delta lobe's (0)
+//! either way. Only walks in [`Dispersion::Fold`] fork: a fork may end with
+//! other wavelengths than the walk, which only a fold keeps out of the
+//! film's densities.
+//!
 //! **Wavelengths.** The walk carries the path's wavelengths. A dispersive
 //! refraction keeps only the hero wavelength; in [`Dispersion::Fold`] (photons,
 //! whose power must stay at the wavelengths of their group) that is folded
@@ -44,7 +62,7 @@ pub use start::{start_light_subpath, LightStart};
 pub use vertex::{adjoint_cos, dir, to_area, to_area_at, EndPoint, Vertex, VertexKind};
 
 use super::roulette::Roulette;
-use crate::bsdf::{SampleFlags, TransportMode};
+use crate::bsdf::{BxdfFlags, SampleFlags, TransportMode};
 use crate::interaction::SurfaceInteraction;
 use crate::math::Ray;
 use crate::sampling::{PathRng, PdfArea, PdfSolidAngle};
@@ -117,6 +135,8 @@ pub struct Scatter {
     pub cos_out: f32,
     /// `pdf_rev` converted to area at the previous vertex.
     pub prev_pdf_rev: PdfArea,
+    /// The sampled lobe reflects.
+    pub reflected: bool,
 }
 
 /// A ray that left the scene.
@@ -148,6 +168,10 @@ pub trait Visitor<R: PathRng + ?Sized> {
     /// True when the walk must compute densities and report each [`Scatter`].
     const DENSITIES: bool = false;
 
+    /// True when [`Visitor::fork`] may fork (walks in [`Dispersion::Fold`]
+    /// only; module doc, "Splitting").
+    const FORKS: bool = false;
+
     /// Called at every surface vertex, with the hit it was made from (its
     /// BSDF built: differentials set, bump applied); says how the walk goes on.
     fn vertex(
@@ -163,9 +187,29 @@ pub trait Visitor<R: PathRng + ?Sized> {
 
     /// Called when the walk's ray leaves the scene.
     fn escaped(&mut self, _e: &Escape, _lambda: &SampledWavelengths) {}
+
+    /// Called after [`Visitor::vertex`] at a vertex whose BSDF is a smooth
+    /// reflection-and-transmission pair: a copy of the visitor with nothing
+    /// accumulated, to walk the reflection alone (module doc, "Splitting"),
+    /// or `None` (the default). A visitor that forks bounds how often and
+    /// how far its forks walk.
+    fn fork(&mut self, _v: &Vertex) -> Option<Self>
+    where
+        Self: Sized,
+    {
+        None
+    }
+
+    /// Adds what a [`Visitor::fork`] found on its branch.
+    fn join(&mut self, _branch: Self)
+    where
+        Self: Sized,
+    {
+    }
 }
 
 /// Walk state between vertices.
+#[derive(Clone)]
 struct State {
     ray: Ray,
     beta: SampledSpectrum,
@@ -200,7 +244,7 @@ where
         return End::Ended;
     }
     let initial = *lambda;
-    let mut st = State {
+    let st = State {
         ray: start.ray,
         beta: start.beta,
         depth: start.depth,
@@ -212,6 +256,31 @@ where
         eta_scale: 1.0,
         roulette_norm: roulette_norm(&start.beta),
     };
+    let fixed = Fixed { scene, w, initial };
+    run(&fixed, lambda, rng, st, visitor)
+}
+
+/// What stays the same along a walk and its forks.
+struct Fixed<'a> {
+    scene: &'a Scene,
+    w: &'a Walk,
+    /// The walk's wavelengths at its start.
+    initial: SampledWavelengths,
+}
+
+/// The walk from state `st` on.
+fn run<R, V>(
+    fixed: &Fixed<'_>,
+    lambda: &mut SampledWavelengths,
+    rng: &mut R,
+    mut st: State,
+    visitor: &mut V,
+) -> End
+where
+    R: PathRng + ?Sized,
+    V: Visitor<R>,
+{
+    let Fixed { scene, w, initial } = fixed;
     while !st.beta.is_black() {
         let Some(mut si) = scene.intersect(&st.ray, f32::INFINITY) else {
             let e = Escape {
@@ -252,11 +321,47 @@ where
         if flow == Flow::Stop || st.depth >= w.max_depth {
             return End::Ended;
         }
-        if let Some(end) = scatter(&v, w, flow, &mut st, visitor, rng) {
+        fork_reflection(fixed, lambda, rng, flow, &v, &st, visitor);
+        if let Some(end) = scatter(&v, w, flow, SampleFlags::ALL, &mut st, visitor, rng) {
             return end;
         }
     }
     End::Ended
+}
+
+/// Walks the reflection alone from `v` with a [`Visitor::fork`] of the
+/// visitor when it forks there, and joins what the fork found (module doc,
+/// "Splitting").
+fn fork_reflection<R, V>(
+    fixed: &Fixed<'_>,
+    lambda: &SampledWavelengths,
+    rng: &mut R,
+    flow: Flow,
+    v: &Vertex,
+    st: &State,
+    visitor: &mut V,
+) where
+    R: PathRng + ?Sized,
+    V: Visitor<R>,
+{
+    // A fork's dispersion is its own: only folded into β (module doc) is it
+    // the same estimate as the walk's.
+    if !V::FORKS || fixed.w.dispersion != Dispersion::Fold {
+        return;
+    }
+    let pair = BxdfFlags::SPECULAR | BxdfFlags::REFLECTION | BxdfFlags::TRANSMISSION;
+    if v.bsdf.as_ref().map(|b| b.flags()) != Some(pair) {
+        return;
+    }
+    let Some(mut branch) = visitor.fork(v) else {
+        return;
+    };
+    let (mut lambda_r, mut st_r) = (*lambda, st.clone());
+    let reflection = SampleFlags::REFLECTION;
+    if scatter(v, fixed.w, flow, reflection, &mut st_r, &mut branch, rng).is_none() {
+        run(fixed, &mut lambda_r, rng, st_r, &mut branch);
+    }
+    visitor.join(branch);
 }
 
 /// Samples the BSDF at `v` and advances `st`; `Some` when the walk ends.
@@ -264,6 +369,7 @@ fn scatter<R, V>(
     v: &Vertex,
     w: &Walk,
     flow: Flow,
+    allowed: SampleFlags,
     st: &mut State,
     visitor: &mut V,
     rng: &mut R,
@@ -278,7 +384,7 @@ where
         return Some(End::Ended);
     }
     let wo = v.wo;
-    let Some(bs) = bsdf.sample_f(wo, rng.u1(), rng.u2(), w.mode, SampleFlags::ALL) else {
+    let Some(bs) = bsdf.sample_f(wo, rng.u1(), rng.u2(), w.mode, allowed) else {
         return Some(End::Absorbed(st.beta));
     };
     if only_delta && !bs.is_specular() {
@@ -312,6 +418,7 @@ where
             pdf_rev,
             cos_out: cos,
             prev_pdf_rev,
+            reflected: bs.is_reflection(),
         });
         st.pdf_dir = pdf_fwd;
         st.prev = Some(EndPoint::of(v));

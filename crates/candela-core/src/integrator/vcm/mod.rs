@@ -325,6 +325,9 @@ pub struct VcmSettings {
     /// Joins (shadow rays) whose MIS weight is below this are made with
     /// probability weight / value (`joinroulette`; 0: all; [`mis::thin`]).
     pub join_roulette: f32,
+    /// A camera subpath whose first vertex is a smooth dielectric follows
+    /// both lobes (`splitspecular`; module doc of [`camera`]).
+    pub split_specular: bool,
 }
 
 impl Default for VcmSettings {
@@ -342,6 +345,7 @@ impl Default for VcmSettings {
             direct_merges: DirectMerges::AfterSpecular,
             variance_lt: true,
             join_roulette: 0.1,
+            split_specular: true,
         }
     }
 }

@@ -15,9 +15,25 @@
 //!   smooth surfaces, the unfolded one across creases, nothing from a thin
 //!   wall's far side).
 //!
+//! **Splitting** (`splitspecular`, on by default; module doc of
+//! [`crate::integrator::subpath`], "Splitting"). At a first vertex that is
+//! a smooth dielectric, a fork of the camera subpath follows the reflection
+//! alone (β times F) along delta scatterings only, and counts only the
+//! emission it reaches that way (E S+ L, the bright light seen in water or
+//! glass); the subpath itself chooses reflection or transmission as always
+//! and counts everything else, leaving that emission out when it took the
+//! reflection. Nothing is counted twice or lost, and E S+ L is found on every
+//! sample through the pixels it lights, at F times its radiance, instead of
+//! on one sample in 1 / F: only the camera subpath samples those paths
+//! (nothing joins or merges at a delta vertex or at the lens), so their
+//! weight is 1 either way and no other weight changes. The fork costs about
+//! one ray per camera subpath that meets water or glass first.
+//!
 //! The pixel's β includes the camera ray's weight; everything found is added
 //! with the film's filter weight to a [`FilmTile`], so the camera side
 //! filters exactly as the path tracer does.
+
+mod next_event;
 
 use super::densities::light_densities;
 use super::light::{LightPaths, LightVertex, PrevVertex};
@@ -26,11 +42,10 @@ use super::mis::{thin, weight, CameraDeferred, CameraPartial, Factors, Partial};
 use super::resample::Resampler;
 use super::variance::{ByLength, LtWeights, LENGTHS};
 use super::{Connections, VcmIntegrator};
-use crate::bsdf::{Bsdf, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrator::driver::{camera_sample, PixelSample};
 use crate::integrator::gather::{gather, Surfel};
 use crate::integrator::nee::{nee_area_density, nee_context};
-use crate::integrator::nee::{sample_light, Receiver};
 use crate::integrator::roulette::Roulette;
 use crate::integrator::subpath::{
     walk, Dispersion, Escape, Flow, Scatter, Start, Vertex, Visitor, Walk,
@@ -131,6 +146,9 @@ impl VcmIntegrator {
             last_after_delta: false,
             specular: true,
             vertices: 0,
+            specular_fork: false,
+            forked: false,
+            fork_has_specular: false,
             nee_ctx: LightSampleContext::at_point(ray.o),
             l: SampledSpectrum::zero(),
             by_length: [0.0; LENGTHS + 1],
@@ -161,6 +179,7 @@ impl VcmIntegrator {
 }
 
 /// The camera pass's visitor.
+#[derive(Clone)]
 struct CameraVisitor<'a, 'b> {
     vcm: &'a VcmIntegrator,
     ctx: &'a RenderContext<'b>,
@@ -183,6 +202,14 @@ struct CameraVisitor<'a, 'b> {
     specular: bool,
     /// Surface vertices visited.
     vertices: u32,
+    /// A fork following a first vertex's reflection: it counts only
+    /// emission reached by delta scatterings (module doc, "Splitting").
+    specular_fork: bool,
+    /// This subpath forked at its first vertex (until its scattering there).
+    forked: bool,
+    /// This subpath forked and took the reflection: emission reached by
+    /// delta scatterings alone is the fork's.
+    fork_has_specular: bool,
     /// Where next-event estimation at the vertex left last would have
     /// sampled a light from (its emission weight, [`nee_area_density`]).
     nee_ctx: LightSampleContext,
@@ -204,6 +231,7 @@ fn unfold(c: SampledSpectrum, cam: bool, light: bool) -> SampledSpectrum {
 
 impl Visitor<Sampler> for CameraVisitor<'_, '_> {
     const DENSITIES: bool = true;
+    const FORKS: bool = true;
 
     fn vertex(
         &mut self,
@@ -220,6 +248,9 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
         self.prev = PrevVertex::of(v);
         self.vertices += 1;
         self.emission(v, lambda);
+        if self.specular_fork {
+            return Flow::SpecularOnly;
+        }
         self.nee_ctx = nee_context(v);
         let max_depth = self.vcm.settings.max_depth;
         let Some(bsdf) = &v.bsdf else {
@@ -246,10 +277,39 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
     fn scattered(&mut self, s: &Scatter) {
         self.pending = Some(*s);
         self.specular &= s.delta;
+        if std::mem::take(&mut self.forked) {
+            self.fork_has_specular = s.reflected;
+        }
+    }
+
+    /// Forks at the first vertex when `splitspecular` is on (module doc,
+    /// "Splitting").
+    fn fork(&mut self, v: &Vertex) -> Option<Self> {
+        if !self.vcm.settings.split_specular || v.depth != 1 || self.specular_fork {
+            return None;
+        }
+        self.forked = true;
+        Some(Self {
+            l: SampledSpectrum::zero(),
+            by_length: [0.0; LENGTHS + 1],
+            specular_fork: true,
+            forked: false,
+            ..self.clone()
+        })
+    }
+
+    fn join(&mut self, branch: Self) {
+        self.l += branch.l;
+        for (a, b) in self.by_length.iter_mut().zip(branch.by_length) {
+            *a += b;
+        }
     }
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
         self.apply_scatter(e.ray.d.normalize().dot(self.prev.n).abs());
+        if self.fork_counts_it() {
+            return;
+        }
         let scene = self.ctx.scene;
         for &id in scene.infinite_lights() {
             let le = scene.light(id).le(&e.ray, lambda);
@@ -314,9 +374,19 @@ impl CameraVisitor<'_, '_> {
         weight(0.0, mis.emission_weight(direct, emission))
     }
 
+    /// Emission reached now is the reflection fork's, not this subpath's
+    /// (module doc, "Splitting").
+    #[inline]
+    fn fork_counts_it(&self) -> bool {
+        self.fork_has_specular && self.specular
+    }
+
     /// s = 0 at a surface vertex that emits.
     fn emission(&mut self, v: &Vertex, lambda: &SampledWavelengths) {
         let Some(id) = v.area_light else { return };
+        if self.fork_counts_it() {
+            return;
+        }
         let scene = self.ctx.scene;
         let le = scene.light(id).l(v.p(), v.it.n, v.it.uv, v.wo, lambda);
         if le.is_black() {
@@ -337,59 +407,6 @@ impl CameraVisitor<'_, '_> {
             self.emission_weight(direct, emission, v.depth - 1)
         };
         self.add(v.depth - 1, v.beta * le * w);
-    }
-
-    /// s = 1: a light sample for `v` [eqs. 44–45].
-    fn next_event(
-        &mut self,
-        v: &Vertex,
-        bsdf: &Bsdf,
-        lambda: &SampledWavelengths,
-        rng: &mut Sampler,
-    ) {
-        let scene = self.ctx.scene;
-        let Some(r) = Receiver::at_vertex(v) else {
-            return;
-        };
-        let Some(ls) = sample_light(scene, scene.light_sampler(), &r, lambda, rng) else {
-            return;
-        };
-        let light = scene.light(ls.light);
-        let e = ls.vertex(scene);
-        let (direct, emission, cos_light) = light_densities(scene, ls.light, &e.it, -ls.wi);
-        if direct <= 0.0 {
-            return;
-        }
-        // An area light point's density is the one this sample was drawn
-        // with, per unit area (nee.rs, `nee_area_density`).
-        let direct = if !light.samples_li_by_area() {
-            ls.pmf * ls.pdf.0 * cos_light / (e.p() - v.p()).length_squared()
-        } else {
-            direct
-        };
-        let bsdf_dir = if light.is_hittable() {
-            bsdf.pdf(v.wo, ls.wi, TransportMode::Radiance, SampleFlags::ALL)
-                .0
-        } else {
-            0.0
-        };
-        let bsdf_rev = bsdf
-            .pdf(ls.wi, v.wo, TransportMode::Importance, SampleFlags::ALL)
-            .0;
-        let cos_recv = ls.wi.dot(v.it.n).abs();
-        let inv_d2 = if e.at_infinity() {
-            1.0
-        } else {
-            1.0 / (e.p() - v.p()).length_squared()
-        };
-        let w_light = super::mis::mis(bsdf_dir * cos_light * inv_d2 / direct);
-        let ratio = emission * cos_recv * inv_d2 / direct;
-        // A merge at v, next to the light, exists after a specular vertex.
-        let merge = self.cp.f.merges_at(true, self.arrived_delta);
-        let w_cam = self
-            .partial(v.depth)
-            .connect_weight(ratio, bsdf_rev, &self.cp.f, merge);
-        self.add(v.depth, v.beta * ls.unweighted() * weight(w_light, w_cam));
     }
 
     /// Connections to the vertices of the pixel's light subpath [eqs.
