@@ -417,7 +417,14 @@ fn sppm_settings(ck: &Check<'_>, c: &Common) -> Result<SppmSettings, BuildError>
         max_depth: c.max_depth,
         seed: photon_seed(ck, c)?,
         wavelength_groups: wavelength_groups(ck)?,
+        split_specular: split_specular(ck)?,
     })
+}
+
+/// `"bool splitspecular"` of the integrators whose camera walks fork at a
+/// first smooth dielectric (`integrator::subpath`, "Splitting"; default on).
+fn split_specular(ck: &Check<'_>) -> Result<bool, BuildError> {
+    Ok(ck.params.get_bool("splitspecular", true)?)
 }
 
 /// PPM's settings; the radius is set by [`finish`].
@@ -428,6 +435,7 @@ fn ppm_settings(ck: &Check<'_>, c: &Common) -> Result<PpmSettings, BuildError> {
         max_depth: c.max_depth,
         seed: photon_seed(ck, c)?,
         wavelength_groups: wavelength_groups(ck)?,
+        split_specular: split_specular(ck)?,
     })
 }
 
@@ -461,6 +469,7 @@ fn photonmap_settings(ck: &Check<'_>, c: &Common) -> Result<PhotonMapSettings, B
         gather_rays: count("gatherrays", d.gather_rays as u64, 1)? as u32,
         seed: c.seed,
         wavelength_groups: wavelength_groups(ck)?,
+        split_specular: split_specular(ck)?,
     })
 }
 
@@ -500,7 +509,7 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
             VcmSettings::default().join_roulette,
             Domain::Closed(0.0, 1.0),
         )?,
-        split_specular: ck.params.get_bool("splitspecular", true)?,
+        split_specular: split_specular(ck)?,
     })
 }
 

@@ -31,6 +31,14 @@
 //!   delta lobes ([`Flow::SpecularOnly`]). Vertices with only delta lobes
 //!   are crossed along them.
 //!
+//! With `split_specular`, a walk whose first vertex is a smooth dielectric
+//! forks there: the fork follows the reflection alone (β times F) and counts
+//! the emission it reaches through delta scatterings, and the walk leaves
+//! that emission out when it took the reflection (module doc of
+//! [`super::subpath`], "Splitting"): a light's glint on water is found on
+//! every sample through it. The fork makes no visible point and estimates
+//! no direct light, so each pixel still has one visible point.
+//!
 //! Depths: vertex d is reached after d − 1 scatterings; light is estimated
 //! at vertices d ≤ `max_depth`. With `emission_beyond` the emission of
 //! vertex `max_depth` + 1 also counts, so a path of `max_depth` scattering
@@ -58,6 +66,8 @@ pub struct CameraWalk {
     pub emission_beyond: bool,
     /// Direct light by MIS of light and BSDF sampling (module doc).
     pub mis_direct: bool,
+    /// Fork at a first vertex that is a smooth dielectric (module doc).
+    pub split_specular: bool,
 }
 
 /// The last vertex the walk left along a non-delta lobe: what the MIS
@@ -110,7 +120,10 @@ struct Eye<'a, F> {
     walk_max_depth: u32,
     mis: bool,
     l: SampledSpectrum,
-    shade: F,
+    /// What the caller does at a vertex; `None` in a fork, which counts
+    /// emission only.
+    shade: Option<F>,
+    split_specular: bool,
     /// Set while the walk is between a non-delta scattering and the next vertex.
     scattered: Option<Scattered>,
 }
@@ -194,6 +207,8 @@ where
     R: PathRng + ?Sized,
     F: FnMut(&Vertex, &SurfaceInteraction, &Bsdf, &mut SampledWavelengths, &mut R) -> Flow,
 {
+    const FORKS: bool = true;
+
     fn vertex(
         &mut self,
         v: &Vertex,
@@ -202,7 +217,7 @@ where
         rng: &mut R,
     ) -> Flow {
         let scattered = self.scattered.take();
-        if let Some(id) = v.area_light {
+        if let Some(id) = v.area_light.filter(|_| !v.fork_emission) {
             let weight = match &scattered {
                 _ if v.after_delta => Some(1.0),
                 Some(s) => Some(s.weight(self.scene, id, -v.wo)),
@@ -212,6 +227,9 @@ where
                 let le = self.scene.light(id).l(v.p(), v.it.n, v.it.uv, v.wo, lambda);
                 self.l += v.beta * le * w;
             }
+        }
+        if self.shade.is_none() {
+            return Flow::SpecularOnly;
         }
         if v.depth > self.max_depth {
             return Flow::Stop;
@@ -234,7 +252,10 @@ where
                 self.l += v.beta * ld;
             }
         }
-        let flow = (self.shade)(v, si, bsdf, lambda, rng);
+        let flow = match &mut self.shade {
+            Some(shade) => shade(v, si, bsdf, lambda, rng),
+            None => Flow::SpecularOnly,
+        };
         if self.mis {
             if flow == Flow::Stop || v.depth >= self.walk_max_depth {
                 self.emission_probe(v, bsdf, lambda, rng);
@@ -247,7 +268,7 @@ where
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
         let scattered = self.scattered.take();
-        if !e.after_delta && scattered.is_none() {
+        if (!e.after_delta && scattered.is_none()) || e.fork_emission {
             return;
         }
         let wi = e.ray.d.normalize();
@@ -259,6 +280,24 @@ where
             };
             self.l += e.beta * le * w;
         }
+    }
+
+    /// Forks at the first vertex with `split_specular` (module doc).
+    fn fork(&self, v: &Vertex) -> Option<Self> {
+        (self.split_specular && v.depth == 1).then(|| Eye {
+            scene: self.scene,
+            max_depth: self.max_depth,
+            walk_max_depth: self.walk_max_depth,
+            mis: self.mis,
+            l: SampledSpectrum::zero(),
+            shade: None,
+            split_specular: false,
+            scattered: None,
+        })
+    }
+
+    fn join(&mut self, branch: Self) {
+        self.l += branch.l;
     }
 }
 
@@ -303,7 +342,8 @@ where
         walk_max_depth,
         mis: cw.mis_direct,
         l: SampledSpectrum::zero(),
-        shade,
+        shade: Some(shade),
+        split_specular: cw.split_specular,
         scattered: None,
     };
     walk(scene, lambda, rng, &w, start, &mut eye);

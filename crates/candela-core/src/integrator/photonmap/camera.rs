@@ -43,6 +43,7 @@ impl CameraSide<'_> {
             max_depth: self.settings.max_depth,
             emission_beyond: true,
             mis_direct: false,
+            split_specular: self.settings.split_specular,
         };
         let mut l = SampledSpectrum::zero();
         let one = SampledSpectrum::one();

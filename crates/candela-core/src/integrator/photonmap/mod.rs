@@ -108,6 +108,9 @@ pub struct PhotonMapSettings {
     pub seed: u64,
     /// Wavelength groups per pass (`wavelengthgroups`).
     pub wavelength_groups: u32,
+    /// Fork the camera walk at a first smooth dielectric (`splitspecular`,
+    /// default true; [`crate::integrator::camera_walk`]).
+    pub split_specular: bool,
 }
 
 impl Default for PhotonMapSettings {
@@ -124,6 +127,7 @@ impl Default for PhotonMapSettings {
             gather_rays: 16,
             seed: 0,
             wavelength_groups: super::wavelengths::DEFAULT_GROUPS,
+            split_specular: true,
         }
     }
 }

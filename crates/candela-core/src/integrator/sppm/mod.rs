@@ -30,7 +30,9 @@ pub use ppm::{ppm_radius2, PpmIntegrator, PpmSettings};
 use super::photon::ShootSettings;
 use super::{Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, RenderContext};
 use crate::film::PassBlock;
-use passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, VisitBuffer, Visits};
+use passes::{
+    camera_pass, pass_wavelengths, photon_pass, pixel_list, visible_point_walk, VisitBuffer, Visits,
+};
 use rayon::prelude::*;
 
 /// α of the radius reduction (Hachisuka & Jensen recommend 2/3).
@@ -50,6 +52,9 @@ pub struct SppmSettings {
     /// Wavelength groups per pass (`wavelengthgroups`, default 4; see
     /// [`crate::integrator::wavelengths`]).
     pub wavelength_groups: u32,
+    /// Fork camera walks at a first smooth dielectric (`splitspecular`,
+    /// default true; [`crate::integrator::camera_walk`]).
+    pub split_specular: bool,
 }
 
 impl Default for SppmSettings {
@@ -60,6 +65,7 @@ impl Default for SppmSettings {
             max_depth: 5,
             seed: 0,
             wavelength_groups: super::wavelengths::DEFAULT_GROUPS,
+            split_specular: true,
         }
     }
 }
@@ -85,7 +91,8 @@ impl SppmIntegrator {
         let s = &self.settings;
         let pixels = pixel_list(ctx.film);
         let pw = pass_wavelengths(s.seed, pass, s.wavelength_groups);
-        if camera_pass(ctx, &pixels, pass as u32, &pw, s.max_depth, out).is_none() {
+        let cw = visible_point_walk(s.max_depth, s.split_specular);
+        if camera_pass(ctx, &pixels, pass as u32, &pw, &cw, out).is_none() {
             return PassOutcome::Cancelled;
         }
         let mut grids = std::mem::take(&mut out.grids);

@@ -168,12 +168,13 @@ const PIXEL_CHUNK: usize = 64;
 /// each pixel at its group's wavelengths in `pw` (`None` if the render was
 /// cancelled meanwhile). The sampler is reset at every pixel, so the
 /// visits do not depend on how the work is split between threads.
+/// `cw` is a [`visible_point_walk`].
 pub fn camera_pass(
     ctx: &RenderContext<'_>,
     pixels: &[UVec2],
     iter: u32,
     pw: &PassWavelengths,
-    max_depth: u32,
+    cw: &CameraWalk,
     out: &mut Visits,
 ) -> Option<()> {
     let g = pw.len();
@@ -206,11 +207,23 @@ pub fn camera_pass(
                     }
                     let slots = extra.get_mut(k * g..(k + 1) * g).unwrap_or_default();
                     sampler.start_pixel_sample(pixels[i], iter, 0);
-                    *v = visit_pixel(ctx, pixels[i], pw, group, max_depth, sampler, slots);
+                    *v = visit_pixel(ctx, pixels[i], pw, group, cw, sampler, slots);
                 }
             },
         );
     (!ctx.cancelled()).then_some(())
+}
+
+/// The camera walk of SPPM's and PPM's visible points: to `max_depth`,
+/// direct light by MIS, pbrt-v4's depth rule (module doc of
+/// [`crate::integrator::camera_walk`]).
+pub fn visible_point_walk(max_depth: u32, split_specular: bool) -> CameraWalk {
+    CameraWalk {
+        max_depth,
+        emission_beyond: false,
+        mis_direct: true,
+        split_specular,
+    }
 }
 
 /// The camera walk of one pixel of group `group`: direct light on the way
@@ -223,18 +236,13 @@ fn visit_pixel(
     pixel: UVec2,
     pw: &PassWavelengths,
     group: usize,
-    max_depth: u32,
+    cw: &CameraWalk,
     sampler: &mut Sampler,
     slots: &mut [Option<Bsdf>],
 ) -> PixelVisit {
     let mut visit = PixelVisit::none(pw.group(group), group);
     let Some(cs) = camera_sample(ctx, pixel, sampler) else {
         return visit;
-    };
-    let cw = CameraWalk {
-        max_depth,
-        emission_beyond: false,
-        mis_direct: true,
     };
     let beta = SampledSpectrum::splat(cs.ray_weight);
     let mut vp = None;
@@ -248,10 +256,10 @@ fn visit_pixel(
         beta,
         &mut visit.lambda,
         sampler,
-        &cw,
+        cw,
         |v, si, bsdf, lam, _| {
             let flags = bsdf.flags();
-            let glossy_last = flags.contains(BxdfFlags::GLOSSY) && v.depth == max_depth;
+            let glossy_last = flags.contains(BxdfFlags::GLOSSY) && v.depth == cw.max_depth;
             if !flags.contains(BxdfFlags::DIFFUSE) && !glossy_last {
                 flat &= bsdf.bxdf.is_wavelength_independent();
                 return Flow::Continue;

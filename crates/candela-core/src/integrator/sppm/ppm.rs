@@ -9,7 +9,9 @@
 //! channels, which the film averages over passes; because the passes are
 //! independent, a render can be split into pass ranges and merged exactly.
 
-use super::passes::{camera_pass, pass_wavelengths, photon_pass, pixel_list, VisitBuffer, Visits};
+use super::passes::{
+    camera_pass, pass_wavelengths, photon_pass, pixel_list, visible_point_walk, VisitBuffer, Visits,
+};
 use super::ALPHA;
 use crate::film::PassBlock;
 use crate::integrator::photon::ShootSettings;
@@ -31,6 +33,9 @@ pub struct PpmSettings {
     /// Wavelength groups per pass (`wavelengthgroups`, default 4; see
     /// [`crate::integrator::wavelengths`]).
     pub wavelength_groups: u32,
+    /// Fork camera walks at a first smooth dielectric (`splitspecular`,
+    /// default true; [`crate::integrator::camera_walk`]).
+    pub split_specular: bool,
 }
 
 /// The PPM integrator.
@@ -93,7 +98,8 @@ impl Integrator for PpmIntegrator {
         };
         let pw = pass_wavelengths(st.seed, pass, st.wavelength_groups);
         let mut guard = self.visits.lock();
-        if camera_pass(ctx, &pixels, pass as u32, &pw, st.max_depth, &mut guard).is_none() {
+        let cw = visible_point_walk(st.max_depth, st.split_specular);
+        if camera_pass(ctx, &pixels, pass as u32, &pw, &cw, &mut guard).is_none() {
             return PassOutcome::Cancelled;
         }
         let mut grids = std::mem::take(&mut guard.grids);

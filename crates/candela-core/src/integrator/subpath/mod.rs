@@ -34,20 +34,25 @@
 //! **Splitting.** A visitor may fork the walk at a vertex whose BSDF is a
 //! pair of delta lobes, a reflection and a transmission (a smooth
 //! dielectric): [`Visitor::fork`] gives a copy of it with nothing
-//! accumulated, which walks the reflection alone (density 1, so its β takes
-//! the Fresnel factor F instead of a choice made with probability F), while
-//! the walk itself goes on choosing between the lobes as always;
-//! [`Visitor::join`] then adds what the copy found. The two walks see the
-//! same paths through the reflection, so the visitor must divide them: each
-//! counts a disjoint part, the copy's weighted by F, the walk's by 1 / F
-//! when it took the reflection [the splitting of Arvo and Kirk 1990,
-//! "Particle transport and image synthesis", §4]. What for: a bright light
-//! seen in that reflection is then found on every sample through the pixels
-//! it lights, at F times its radiance, instead of on one sample in 1 / F at
-//! full radiance. The densities a visitor is told are a delta lobe's (0)
-//! either way. Only walks in [`Dispersion::Fold`] fork: a fork may end with
-//! other wavelengths than the walk, which only a fold keeps out of the
-//! film's densities.
+//! accumulated, the fork walks the reflection alone (density 1, so its β
+//! takes the Fresnel factor F instead of a choice made with probability F)
+//! and then along delta lobes only, and [`Visitor::join`] adds what it
+//! counted. The walk itself goes on choosing between the lobes as always.
+//! The two see the same paths through the reflection, and divide them: the
+//! fork counts only the emission it reaches (E S+ L, a light seen in the
+//! water or glass), the walk everything else, which it is told by
+//! [`Vertex::fork_emission`] and [`Escape::fork_emission`] at the vertices
+//! and escapes whose emission is the fork's (reached by the reflection and
+//! delta scatterings since) [splitting: Arvo and Kirk 1990, "Particle
+//! transport and image synthesis", §4]. What for: a bright light seen in
+//! that reflection is then found on every sample through the pixels it
+//! lights, at F times its radiance, instead of on one sample in 1 / F at
+//! full radiance. A fork folds its dispersion into β ([`Dispersion::Fold`])
+//! whatever the walk does, so what it counts is at the wavelengths the walk
+//! had at the fork (were the walk to end with its secondary wavelengths
+//! terminated, the film would weigh the fork's hero wavelength by their
+//! count: the same expectation, as for a fold). The densities a visitor is
+//! told are a delta lobe's (0) either way.
 //!
 //! **Wavelengths.** The walk carries the path's wavelengths. A dispersive
 //! refraction keeps only the hero wavelength; in [`Dispersion::Fold`] (photons,
@@ -135,8 +140,6 @@ pub struct Scatter {
     pub cos_out: f32,
     /// `pdf_rev` converted to area at the previous vertex.
     pub prev_pdf_rev: PdfArea,
-    /// The sampled lobe reflects.
-    pub reflected: bool,
 }
 
 /// A ray that left the scene.
@@ -150,6 +153,8 @@ pub struct Escape {
     pub pdf_dir: PdfSolidAngle,
     /// It left from the start or by a delta scattering.
     pub after_delta: bool,
+    /// Its emission is a fork's to count ([`Vertex::fork_emission`]).
+    pub fork_emission: bool,
 }
 
 /// How a walk ended.
@@ -168,8 +173,7 @@ pub trait Visitor<R: PathRng + ?Sized> {
     /// True when the walk must compute densities and report each [`Scatter`].
     const DENSITIES: bool = false;
 
-    /// True when [`Visitor::fork`] may fork (walks in [`Dispersion::Fold`]
-    /// only; module doc, "Splitting").
+    /// True when [`Visitor::fork`] may fork (module doc, "Splitting").
     const FORKS: bool = false;
 
     /// Called at every surface vertex, with the hit it was made from (its
@@ -190,10 +194,11 @@ pub trait Visitor<R: PathRng + ?Sized> {
 
     /// Called after [`Visitor::vertex`] at a vertex whose BSDF is a smooth
     /// reflection-and-transmission pair: a copy of the visitor with nothing
-    /// accumulated, to walk the reflection alone (module doc, "Splitting"),
-    /// or `None` (the default). A visitor that forks bounds how often and
-    /// how far its forks walk.
-    fn fork(&mut self, _v: &Vertex) -> Option<Self>
+    /// accumulated, to walk the reflection alone and count the emission it
+    /// reaches (module doc, "Splitting"), or `None` (the default). The
+    /// walk treats the copy's [`Flow::Continue`] as [`Flow::SpecularOnly`];
+    /// a visitor that forks bounds how often.
+    fn fork(&self, _v: &Vertex) -> Option<Self>
     where
         Self: Sized,
     {
@@ -224,6 +229,12 @@ struct State {
     /// 1 / max_λ of the starting β: roulette weighs the share of it the
     /// walk still carries, whatever the light's power ([`Roulette`]).
     roulette_norm: f32,
+    /// This is a fork's walk: it goes on along delta lobes only.
+    fork: bool,
+    /// The walk forked at the vertex it is scattering from.
+    forked_here: bool,
+    /// Emission reached now is a fork's ([`Vertex::fork_emission`]).
+    fork_emission: bool,
 }
 
 /// Walks from `start` until the visitor, the depth limit, absorption or an
@@ -255,6 +266,9 @@ where
         any_non_specular: false,
         eta_scale: 1.0,
         roulette_norm: roulette_norm(&start.beta),
+        fork: false,
+        forked_here: false,
+        fork_emission: false,
     };
     let fixed = Fixed { scene, w, initial };
     run(&fixed, lambda, rng, st, visitor)
@@ -288,6 +302,7 @@ where
                 beta: st.beta,
                 pdf_dir: st.pdf_dir,
                 after_delta: st.after_delta,
+                fork_emission: st.fork_emission,
             };
             visitor.escaped(&e, lambda);
             return End::Escaped(st.beta);
@@ -308,6 +323,7 @@ where
         v.depth = st.depth;
         v.after_delta = st.after_delta;
         v.caustic = st.scattered && !st.any_non_specular;
+        v.fork_emission = st.fork_emission;
         if V::DENSITIES {
             v.pdf_fwd = match &st.prev {
                 Some(p) if p.at_infinity => {
@@ -317,11 +333,14 @@ where
                 None => PdfArea(0.0),
             };
         }
-        let flow = visitor.vertex(&v, &si, lambda, rng);
+        let flow = match visitor.vertex(&v, &si, lambda, rng) {
+            Flow::Continue if st.fork => Flow::SpecularOnly,
+            flow => flow,
+        };
         if flow == Flow::Stop || st.depth >= w.max_depth {
             return End::Ended;
         }
-        fork_reflection(fixed, lambda, rng, flow, &v, &st, visitor);
+        fork_reflection(fixed, lambda, rng, flow, &v, &mut st, visitor);
         if let Some(end) = scatter(&v, w, flow, SampleFlags::ALL, &mut st, visitor, rng) {
             return end;
         }
@@ -330,38 +349,48 @@ where
 }
 
 /// Walks the reflection alone from `v` with a [`Visitor::fork`] of the
-/// visitor when it forks there, and joins what the fork found (module doc,
-/// "Splitting").
+/// visitor when it forks there, joins what the fork found, and marks `st`
+/// as forked here (module doc, "Splitting").
 fn fork_reflection<R, V>(
     fixed: &Fixed<'_>,
     lambda: &SampledWavelengths,
     rng: &mut R,
     flow: Flow,
     v: &Vertex,
-    st: &State,
+    st: &mut State,
     visitor: &mut V,
 ) where
     R: PathRng + ?Sized,
     V: Visitor<R>,
 {
-    // A fork's dispersion is its own: only folded into β (module doc) is it
-    // the same estimate as the walk's.
-    if !V::FORKS || fixed.w.dispersion != Dispersion::Fold {
-        return;
-    }
     let pair = BxdfFlags::SPECULAR | BxdfFlags::REFLECTION | BxdfFlags::TRANSMISSION;
-    if v.bsdf.as_ref().map(|b| b.flags()) != Some(pair) {
+    if !V::FORKS || v.bsdf.as_ref().map(|b| b.flags()) != Some(pair) {
         return;
     }
     let Some(mut branch) = visitor.fork(v) else {
         return;
     };
-    let (mut lambda_r, mut st_r) = (*lambda, st.clone());
+    let w = Walk {
+        dispersion: Dispersion::Fold,
+        ..*fixed.w
+    };
+    let at_fork = Fixed {
+        scene: fixed.scene,
+        w: &w,
+        initial: *lambda,
+    };
+    let mut lambda_r = *lambda;
+    let mut st_r = State {
+        fork: true,
+        fork_emission: false,
+        ..st.clone()
+    };
     let reflection = SampleFlags::REFLECTION;
-    if scatter(v, fixed.w, flow, reflection, &mut st_r, &mut branch, rng).is_none() {
-        run(fixed, &mut lambda_r, rng, st_r, &mut branch);
+    if scatter(v, &w, flow, reflection, &mut st_r, &mut branch, rng).is_none() {
+        run(&at_fork, &mut lambda_r, rng, st_r, &mut branch);
     }
     visitor.join(branch);
+    st.forked_here = true;
 }
 
 /// Samples the BSDF at `v` and advances `st`; `Some` when the walk ends.
@@ -418,13 +447,14 @@ where
             pdf_rev,
             cos_out: cos,
             prev_pdf_rev,
-            reflected: bs.is_reflection(),
         });
         st.pdf_dir = pdf_fwd;
         st.prev = Some(EndPoint::of(v));
     } else if bs.is_specular() {
         st.pdf_dir = PdfSolidAngle(0.0);
     }
+    let forked = std::mem::take(&mut st.forked_here);
+    st.fork_emission = bs.is_specular() && (st.fork_emission || (forked && bs.is_reflection()));
     st.after_delta = bs.is_specular();
     st.scattered = true;
     st.any_non_specular |= !bs.is_specular();

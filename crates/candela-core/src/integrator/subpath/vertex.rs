@@ -75,6 +75,10 @@ pub struct Vertex {
     /// Reached through one or more scatterings, every one of them delta (on
     /// a light subpath: an L S+ path, a caustic).
     pub caustic: bool,
+    /// Its emission is a fork's to count, not this walk's: the walk forked
+    /// at an earlier vertex, took the reflection there, and scattered along
+    /// delta lobes only since (module doc of [`super`], "Splitting").
+    pub fork_emission: bool,
 }
 
 impl Vertex {
@@ -101,6 +105,7 @@ impl Vertex {
             depth: 0,
             after_delta: true,
             caustic: false,
+            fork_emission: false,
         }
     }
 

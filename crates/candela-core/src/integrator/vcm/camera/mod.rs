@@ -147,8 +147,6 @@ impl VcmIntegrator {
             specular: true,
             vertices: 0,
             specular_fork: false,
-            forked: false,
-            fork_has_specular: false,
             nee_ctx: LightSampleContext::at_point(ray.o),
             l: SampledSpectrum::zero(),
             by_length: [0.0; LENGTHS + 1],
@@ -203,13 +201,8 @@ struct CameraVisitor<'a, 'b> {
     /// Surface vertices visited.
     vertices: u32,
     /// A fork following a first vertex's reflection: it counts only
-    /// emission reached by delta scatterings (module doc, "Splitting").
+    /// emission (module doc, "Splitting").
     specular_fork: bool,
-    /// This subpath forked at its first vertex (until its scattering there).
-    forked: bool,
-    /// This subpath forked and took the reflection: emission reached by
-    /// delta scatterings alone is the fork's.
-    fork_has_specular: bool,
     /// Where next-event estimation at the vertex left last would have
     /// sampled a light from (its emission weight, [`nee_area_density`]).
     nee_ctx: LightSampleContext,
@@ -277,23 +270,18 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
     fn scattered(&mut self, s: &Scatter) {
         self.pending = Some(*s);
         self.specular &= s.delta;
-        if std::mem::take(&mut self.forked) {
-            self.fork_has_specular = s.reflected;
-        }
     }
 
     /// Forks at the first vertex when `splitspecular` is on (module doc,
     /// "Splitting").
-    fn fork(&mut self, v: &Vertex) -> Option<Self> {
-        if !self.vcm.settings.split_specular || v.depth != 1 || self.specular_fork {
+    fn fork(&self, v: &Vertex) -> Option<Self> {
+        if !self.vcm.settings.split_specular || v.depth != 1 {
             return None;
         }
-        self.forked = true;
         Some(Self {
             l: SampledSpectrum::zero(),
             by_length: [0.0; LENGTHS + 1],
             specular_fork: true,
-            forked: false,
             ..self.clone()
         })
     }
@@ -307,7 +295,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
 
     fn escaped(&mut self, e: &Escape, lambda: &SampledWavelengths) {
         self.apply_scatter(e.ray.d.normalize().dot(self.prev.n).abs());
-        if self.fork_counts_it() {
+        if e.fork_emission {
             return;
         }
         let scene = self.ctx.scene;
@@ -374,17 +362,10 @@ impl CameraVisitor<'_, '_> {
         weight(0.0, mis.emission_weight(direct, emission))
     }
 
-    /// Emission reached now is the reflection fork's, not this subpath's
-    /// (module doc, "Splitting").
-    #[inline]
-    fn fork_counts_it(&self) -> bool {
-        self.fork_has_specular && self.specular
-    }
-
     /// s = 0 at a surface vertex that emits.
     fn emission(&mut self, v: &Vertex, lambda: &SampledWavelengths) {
         let Some(id) = v.area_light else { return };
-        if self.fork_counts_it() {
+        if v.fork_emission {
             return;
         }
         let scene = self.ctx.scene;
