@@ -51,8 +51,9 @@
 //! whatever the walk does, so what it counts is at the wavelengths the walk
 //! had at the fork (were the walk to end with its secondary wavelengths
 //! terminated, the film would weigh the fork's hero wavelength by their
-//! count: the same expectation, as for a fold). The densities a visitor is
-//! told are a delta lobe's (0) either way.
+//! count: the same expectation, as for a fold), and plays no roulette (its
+//! walk is delta scatterings to `max_depth` at most). The densities a
+//! visitor is told are a delta lobe's (0) either way.
 //!
 //! **Wavelengths.** The walk carries the path's wavelengths. A dispersive
 //! refraction keeps only the hero wavelength; in [`Dispersion::Fold`] (photons,
@@ -370,8 +371,11 @@ fn fork_reflection<R, V>(
     let Some(mut branch) = visitor.fork(v) else {
         return;
     };
+    // No roulette: the fork's β starts at F times the walk's, which the
+    // walk's rule would read as a path hardly worth going on with.
     let w = Walk {
         dispersion: Dispersion::Fold,
+        roulette: None,
         ..*fixed.w
     };
     let at_fork = Fixed {
@@ -427,29 +431,7 @@ where
     let before = st.beta;
     st.beta *= bs.f * (cos * correction / bs.pdf.0);
     if V::DENSITIES {
-        let mut pdf_fwd = if bs.pdf_is_proportional {
-            bsdf.pdf(wo, bs.wi, w.mode, SampleFlags::ALL)
-        } else {
-            bs.pdf
-        };
-        let mut pdf_rev = bsdf.pdf(bs.wi, wo, w.mode.adjoint(), SampleFlags::ALL);
-        if bs.is_specular() {
-            pdf_fwd = PdfSolidAngle(0.0);
-            pdf_rev = PdfSolidAngle(0.0);
-        }
-        let prev_pdf_rev = match &st.prev {
-            Some(p) => to_area_at(pdf_rev, v.p(), p),
-            None => PdfArea(0.0),
-        };
-        visitor.scattered(&Scatter {
-            delta: bs.is_specular(),
-            pdf_fwd,
-            pdf_rev,
-            cos_out: cos,
-            prev_pdf_rev,
-        });
-        st.pdf_dir = pdf_fwd;
-        st.prev = Some(EndPoint::of(v));
+        report_densities(v, bsdf, &bs, w.mode, cos, st, visitor);
     } else if bs.is_specular() {
         st.pdf_dir = PdfSolidAngle(0.0);
     }
@@ -476,6 +458,50 @@ where
         }
         _ => None,
     }
+}
+
+/// Tells a [`Visitor::DENSITIES`] visitor the [`Scatter`] of sample `bs`
+/// at `v` (|ωi·ns| `cos`), and keeps the forward density and `v` in `st`
+/// for the next vertex's conversion.
+fn report_densities<R, V>(
+    v: &Vertex,
+    bsdf: &crate::bsdf::Bsdf,
+    bs: &crate::bsdf::BsdfSample,
+    mode: TransportMode,
+    cos: f32,
+    st: &mut State,
+    visitor: &mut V,
+) where
+    R: PathRng + ?Sized,
+    V: Visitor<R>,
+{
+    let wo = v.wo;
+    let (pdf_fwd, pdf_rev) = if bs.is_specular() {
+        (PdfSolidAngle(0.0), PdfSolidAngle(0.0))
+    } else {
+        let pdf_fwd = if bs.pdf_is_proportional {
+            bsdf.pdf(wo, bs.wi, mode, SampleFlags::ALL)
+        } else {
+            bs.pdf
+        };
+        (
+            pdf_fwd,
+            bsdf.pdf(bs.wi, wo, mode.adjoint(), SampleFlags::ALL),
+        )
+    };
+    let prev_pdf_rev = match &st.prev {
+        Some(p) => to_area_at(pdf_rev, v.p(), p),
+        None => PdfArea(0.0),
+    };
+    visitor.scattered(&Scatter {
+        delta: bs.is_specular(),
+        pdf_fwd,
+        pdf_rev,
+        cos_out: cos,
+        prev_pdf_rev,
+    });
+    st.pdf_dir = pdf_fwd;
+    st.prev = Some(EndPoint::of(v));
 }
 
 /// 1 / max_λ β of a walk's start, or 1 when that is not a positive finite
