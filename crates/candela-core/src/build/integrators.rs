@@ -496,7 +496,11 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
         max_depth: c.max_depth,
         radius: 1.0,
         radius_from_density: false,
-        alpha: ck.float("alpha", 0.75, Domain::LeftOpen(0.0, 1.0))?,
+        alpha: ck.float(
+            "alpha",
+            VcmSettings::default().alpha,
+            Domain::LeftOpen(0.0, 1.0),
+        )?,
         light_paths: photons_per_iteration(ck)?,
         seed: photon_seed(ck, c)?,
         regularize: c.regularize,

@@ -153,10 +153,22 @@
 //! the Cornell box's direct light 0.00065 instead of 0.00131 at 36
 //! iterations, the whole image −17 %, caustic-glass within 1 %.
 //!
-//! **α.** The default 0.75 is the paper's (Georgiev et al. 2012, §7 and
-//! SmallVCM's default): VCM's merges only carry the paths connections
-//! sample badly (caustics), whose variance benefits from a radius that
-//! shrinks more slowly than SPPM's 2/3.
+//! **α.** The default is 0.5, below both the paper's 0.75 (Georgiev et al.
+//! 2012, §7; SmallVCM) and Knaus and Zwicker's asymptotically best 2/3:
+//! at the times renders are made, the merges' error is mostly the kernel's
+//! bias, and a sharp caustic seen through water is blurred for longer by a
+//! radius that shrinks slowly. Measured against low-bias references (the
+//! pool at 160×120, vcm at radius 0.025 for 2 × 24 000 iterations;
+//! caustic-glass at 175×250, radius 0.02 for 600 s), relMSE at 4 / 16 s,
+//! two threads, one seed: the pool 0.0333 / 0.0235 at α = 0.75, 0.0275 /
+//! 0.0163 at 2/3, 0.0207 / 0.0092 at 0.5 (sppm 0.0206 / 0.0094);
+//! caustic-glass 0.0124 / 0.0047, 0.0123 / 0.0044, 0.0127 / 0.0046 (sppm
+//! 0.0140 / 0.0051); the Cornell box at 128² against a path-traced
+//! reference, two seeds, 0.00086 / 0.00034 at 0.75 and 0.00090 / 0.00030
+//! at 0.5. Against references that were themselves means of vcm and sppm
+//! renders of a few thousand iterations, blurred by their own kernels, the
+//! slow 0.75 had looked best: a reference's kernel bias favours the
+//! estimators that share it.
 
 mod camera;
 pub mod densities;
@@ -302,7 +314,7 @@ pub struct VcmSettings {
     /// `radius` was not written: it is one pixel footprint, and the first
     /// pass replaces it by the light vertices' density ([`pilot`]).
     pub radius_from_density: bool,
-    /// Radius reduction α (`alpha`, 0.75).
+    /// Radius reduction α (`alpha`, 0.5; module doc).
     pub alpha: f32,
     /// Light paths per iteration (`photonsperiteration`; ≤ 0: one per pixel
     /// of the full film).
@@ -336,7 +348,7 @@ impl Default for VcmSettings {
             max_depth: 5,
             radius: 1.0,
             radius_from_density: false,
-            alpha: 0.75,
+            alpha: 0.5,
             light_paths: -1,
             seed: 0,
             regularize: false,
