@@ -337,8 +337,9 @@ pub struct VcmSettings {
     /// Joins (shadow rays) whose MIS weight is below this are made with
     /// probability weight / value (`joinroulette`; 0: all; [`mis::thin`]).
     pub join_roulette: f32,
-    /// A camera subpath whose first vertex is a smooth dielectric follows
-    /// both lobes (`splitspecular`; module doc of [`camera`]).
+    /// A camera subpath whose first vertex is a smooth dielectric forks
+    /// there to count the emission its reflection reaches (`splitspecular`;
+    /// module doc of [`crate::integrator::subpath`], "Splitting").
     pub split_specular: bool,
 }
 
