@@ -13,6 +13,11 @@
 //! (0.032; 0.043 at 1, 0.065 at 6). Without the direct merges the Cornell
 //! box is best near 2 footprints.
 //!
+//! (Those references were means of vcm and sppm renders of a few thousand
+//! iterations, blurred by their own kernels, which favours large radii; against
+//! low-bias references (module doc of [`super`], "α") the pool is best near 2
+//! footprints, where this rule gives it 4.2, and caustic-glass still at 6.)
+//!
 //! So without a written `radius` the first iteration's radius is the one
 //! whose disk holds [`TARGET_NEIGHBOURS`] other light vertices around the
 //! median stored vertex, counting only vertices that merge (beyond the
