@@ -101,6 +101,7 @@ pub(crate) fn meter_path(max_depth: u32) -> PathIntegrator {
         settings: PathSettings {
             max_depth,
             regularize: false,
+            split_specular: true,
         },
     }
 }

@@ -288,7 +288,7 @@ fn construct(
     warnings: &mut Vec<String>,
 ) -> Result<(Settings, usize), BuildError> {
     Ok(match kind {
-        IntegratorKind::Path => (Settings::Path(path_settings(common)), 0),
+        IntegratorKind::Path => (Settings::Path(path_settings(ck, common)?), 0),
         IntegratorKind::LightPath => (
             Settings::LightPath(LightTracerSettings {
                 max_depth: common.max_depth,
@@ -352,11 +352,12 @@ fn render_seed(desc: &SceneDescription, ov: &Overrides) -> Result<u64, BuildErro
     })
 }
 
-fn path_settings(c: &Common) -> PathSettings {
-    PathSettings {
+fn path_settings(ck: &Check<'_>, c: &Common) -> Result<PathSettings, BuildError> {
+    Ok(PathSettings {
         max_depth: c.max_depth,
         regularize: c.regularize,
-    }
+        split_specular: split_specular(ck)?,
+    })
 }
 
 /// Deepest `maxdepth` whose strategies BDPT can write as images.

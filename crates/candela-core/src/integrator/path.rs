@@ -10,6 +10,14 @@
 //! accumulated η² so refraction does not bias it, as pbrt-v4) or at
 //! `maxdepth` scattering events.
 //!
+//! **Glints.** Where the camera ray's first hit is a smooth dielectric, a
+//! fork follows its reflection alone (β times the Fresnel factor F) along
+//! delta scatterings and counts the emission it reaches; the path itself
+//! leaves exactly that emission out when it took the reflection
+//! (`splitspecular`, default true; the walker's version and the argument
+//! are in the module doc of [`crate::integrator::subpath`], "Splitting").
+//! A light seen in water or glass is then found on every sample through it.
+//!
 //! Stochastic layered BSDFs return samples whose pdf is only proportional to
 //! the true density (`pdf_is_proportional`): f/p is still the right throughput
 //! weight, but MIS on the emitter the sample hits must use the same density
@@ -22,7 +30,7 @@ use super::{
     driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, PixelEstimator,
     RenderContext,
 };
-use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, BsdfSample, BxdfFlags, SampleFlags, TransportMode};
 use crate::film::{PassBlock, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
 use crate::light::{LightChooser, LightSampleContext};
@@ -39,6 +47,8 @@ pub struct PathSettings {
     pub max_depth: u32,
     /// Roughen near-specular lobes after the first non-specular bounce (biased; off by default).
     pub regularize: bool,
+    /// Fork at a first smooth dielectric (`splitspecular`; module doc).
+    pub split_specular: bool,
 }
 
 impl Default for PathSettings {
@@ -46,6 +56,7 @@ impl Default for PathSettings {
         Self {
             max_depth: 5,
             regularize: false,
+            split_specular: true,
         }
     }
 }
@@ -79,6 +90,7 @@ impl Integrator for PathIntegrator {
 }
 
 /// State carried from one path vertex to the next.
+#[derive(Clone)]
 struct PathState {
     l: SampledSpectrum,
     beta: SampledSpectrum,
@@ -94,6 +106,11 @@ struct PathState {
     /// The first ray was not BSDF-sampled (a camera ray): emission at the
     /// first hit takes no MIS weight.
     unweighted_start: bool,
+    /// The path forked at the vertex it is scattering from (module doc).
+    forked_here: bool,
+    /// Emission reached now is the fork's: the path took the reflection
+    /// where it forked and scattered along delta lobes only since.
+    fork_emission: bool,
 }
 
 impl PixelEstimator for PathIntegrator {
@@ -125,6 +142,8 @@ impl PathState {
             prev_ctx: from,
             eta_scale: 1.0,
             unweighted_start: pdf.is_none(),
+            forked_here: false,
+            fork_emission: false,
         }
     }
 }
@@ -179,6 +198,10 @@ impl PathIntegrator {
                 bsdf.regularize();
             }
             let wo = -ray.d.normalize();
+            if st.depth == 1 && self.forks_at(&bsdf) {
+                st.l += self.reflection_fork(ctx, &si, &bsdf, wo, &st, lambda, sampler);
+                st.forked_here = true;
+            }
             if bsdf.flags().is_non_specular() {
                 let r = Receiver::at_hit(&si, &bsdf, wo);
                 if let Some(ls) =
@@ -213,6 +236,9 @@ impl PathIntegrator {
         lambda: &SampledWavelengths,
         st: &mut PathState,
     ) {
+        if st.fork_emission {
+            return;
+        }
         for &id in scene.infinite_lights() {
             let light = scene.light(id);
             let le = light.le(ray, lambda);
@@ -237,7 +263,9 @@ impl PathIntegrator {
         lambda: &SampledWavelengths,
         st: &mut PathState,
     ) {
-        let Some(id) = si.area_light else { return };
+        let Some(id) = si.area_light.filter(|_| !st.fork_emission) else {
+            return;
+        };
         let light = scene.light(id);
         let le = light.l(si.p(), si.n(), si.it.uv, si.wo, lambda);
         if le.is_black() {
@@ -269,12 +297,81 @@ impl PathIntegrator {
         } else {
             bs.pdf.0
         };
+        let forked = std::mem::take(&mut st.forked_here);
+        st.fork_emission = bs.is_specular() && (st.fork_emission || (forked && bs.is_reflection()));
         st.specular_bounce = bs.is_specular();
         st.any_non_specular |= !bs.is_specular();
         if bs.is_transmission() {
             st.eta_scale *= bs.eta * bs.eta;
         }
         st.prev_ctx = LightSampleContext::from_surface(si);
+    }
+
+    /// Whether the path forks at a first vertex with this BSDF: a smooth
+    /// reflection-and-transmission pair (module doc).
+    fn forks_at(&self, bsdf: &Bsdf) -> bool {
+        let pair = BxdfFlags::SPECULAR | BxdfFlags::REFLECTION | BxdfFlags::TRANSMISSION;
+        self.settings.split_specular && bsdf.flags() == pair
+    }
+
+    /// The fork at `si` (module doc): the reflection alone, then delta
+    /// scatterings only, no roulette; the emission found, with β times F.
+    /// A dispersive refraction on the way is folded into β, so the estimate
+    /// is at the wavelengths the path had here.
+    #[allow(clippy::too_many_arguments)]
+    fn reflection_fork(
+        &self,
+        ctx: &RenderContext<'_>,
+        si: &SurfaceInteraction,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        st: &PathState,
+        lambda: &SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
+        let (u, u2) = (sampler.get_1d(), sampler.get_2d());
+        let mode = TransportMode::Radiance;
+        let Some(bs) = bsdf.sample_f(wo, u, u2, mode, SampleFlags::REFLECTION) else {
+            return SampledSpectrum::zero();
+        };
+        let mut fork = PathState {
+            l: SampledSpectrum::zero(),
+            ..st.clone()
+        };
+        self.scatter(si, bsdf, wo, &bs, &mut fork);
+        fork.fork_emission = false;
+        let scene = ctx.scene;
+        let (initial, mut lam) = (*lambda, *lambda);
+        let mut ray = si.spawn_ray(bs.wi);
+        loop {
+            let Some(mut hit) = scene.intersect(&ray, f32::INFINITY) else {
+                self.add_infinite_light(scene, &ray, &lam, &mut fork);
+                break;
+            };
+            self.add_surface_emission(scene, &hit, &lam, &mut fork);
+            let was_terminated = lam.secondary_terminated();
+            let Some(b) = scene.bsdf(&mut hit, &mut lam) else {
+                ray = hit.spawn_ray(ray.d);
+                continue;
+            };
+            if lam.secondary_terminated() && !was_terminated {
+                fork.beta *= initial.pdf().safe_div(lam.pdf());
+            }
+            if fork.depth == self.settings.max_depth || !b.flags().is_specular() {
+                break;
+            }
+            fork.depth += 1;
+            let w = -ray.d.normalize();
+            let (u, u2) = (sampler.get_1d(), sampler.get_2d());
+            match b.sample_f(w, u, u2, mode, SampleFlags::ALL) {
+                Some(s) if s.is_specular() => {
+                    self.scatter(&hit, &b, w, &s, &mut fork);
+                    ray = hit.spawn_ray(s.wi);
+                }
+                _ => break,
+            }
+        }
+        fork.l
     }
 
     /// Russian roulette ([`Roulette::Throughput`]); returns false to stop.
