@@ -14,8 +14,8 @@
 //! fork follows its reflection alone (β times the Fresnel factor F) along
 //! delta scatterings and counts the emission it reaches; the path itself
 //! leaves exactly that emission out when it took the reflection
-//! (`splitspecular`, default true; the walker's version and the argument
-//! are in the module doc of [`crate::integrator::subpath`], "Splitting").
+//! (`splitspecular`, default true; the fork is walked by the one walker,
+//! whose module doc, "Splitting", has the argument: [`crate::integrator::subpath`]).
 //! A light seen in water or glass is then found on every sample through it.
 //!
 //! Stochastic layered BSDFs return samples whose pdf is only proportional to
@@ -26,17 +26,18 @@
 
 use super::nee::{sample_light, Receiver};
 use super::roulette::Roulette;
+use super::subpath::{self, Start};
 use super::{
     driver, Integrator, IntegratorKind, IntegratorState, PassOutcome, PassWork, PixelEstimator,
     RenderContext,
 };
-use crate::bsdf::{Bsdf, BsdfSample, BxdfFlags, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
 use crate::film::{PassBlock, SplatBuffer};
 use crate::interaction::SurfaceInteraction;
 use crate::light::{LightChooser, LightSampleContext};
 use crate::math::{Ray, Vec3};
 use crate::sampler::Sampler;
-use crate::sampling::power_heuristic;
+use crate::sampling::{power_heuristic, PdfSolidAngle};
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -90,7 +91,6 @@ impl Integrator for PathIntegrator {
 }
 
 /// State carried from one path vertex to the next.
-#[derive(Clone)]
 struct PathState {
     l: SampledSpectrum,
     beta: SampledSpectrum,
@@ -199,7 +199,8 @@ impl PathIntegrator {
             }
             let wo = -ray.d.normalize();
             if st.depth == 1 && self.forks_at(&bsdf) {
-                st.l += self.reflection_fork(ctx, &si, &bsdf, wo, &st, lambda, sampler);
+                let at = (&bsdf, wo);
+                st.l += self.reflection_fork(ctx, &si, at, st.beta, lambda, sampler);
                 st.forked_here = true;
             }
             if bsdf.flags().is_non_specular() {
@@ -307,25 +308,19 @@ impl PathIntegrator {
         st.prev_ctx = LightSampleContext::from_surface(si);
     }
 
-    /// Whether the path forks at a first vertex with this BSDF: a smooth
-    /// reflection-and-transmission pair (module doc).
+    /// Whether the path forks at a first vertex with this BSDF (module doc).
     fn forks_at(&self, bsdf: &Bsdf) -> bool {
-        let pair = BxdfFlags::SPECULAR | BxdfFlags::REFLECTION | BxdfFlags::TRANSMISSION;
-        self.settings.split_specular && bsdf.flags() == pair
+        self.settings.split_specular && subpath::forks_at(bsdf)
     }
 
-    /// The fork at `si` (module doc): the reflection alone, then delta
-    /// scatterings only, no roulette; the emission found, with β times F.
-    /// A dispersive refraction on the way is folded into β, so the estimate
-    /// is at the wavelengths the path had here.
-    #[allow(clippy::too_many_arguments)]
+    /// The fork at `si` with throughput `beta` (module doc): the reflection
+    /// alone, then the walker's [`subpath::delta_emission`].
     fn reflection_fork(
         &self,
         ctx: &RenderContext<'_>,
         si: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        st: &PathState,
+        (bsdf, wo): (&Bsdf, Vec3),
+        beta: SampledSpectrum,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
     ) -> SampledSpectrum {
@@ -334,44 +329,17 @@ impl PathIntegrator {
         let Some(bs) = bsdf.sample_f(wo, u, u2, mode, SampleFlags::REFLECTION) else {
             return SampledSpectrum::zero();
         };
-        let mut fork = PathState {
-            l: SampledSpectrum::zero(),
-            ..st.clone()
+        let start = Start {
+            ray: si.spawn_ray(bs.wi),
+            beta: beta * bs.f * (bs.wi.dot(si.shading.n).abs() / bs.pdf.0),
+            depth: 1,
+            from: None,
+            pdf_dir: PdfSolidAngle(0.0),
         };
-        self.scatter(si, bsdf, wo, &bs, &mut fork);
-        fork.fork_emission = false;
-        let scene = ctx.scene;
-        let (initial, mut lam) = (*lambda, *lambda);
-        let mut ray = si.spawn_ray(bs.wi);
-        loop {
-            let Some(mut hit) = scene.intersect(&ray, f32::INFINITY) else {
-                self.add_infinite_light(scene, &ray, &lam, &mut fork);
-                break;
-            };
-            self.add_surface_emission(scene, &hit, &lam, &mut fork);
-            let was_terminated = lam.secondary_terminated();
-            let Some(b) = scene.bsdf(&mut hit, &mut lam) else {
-                ray = hit.spawn_ray(ray.d);
-                continue;
-            };
-            if lam.secondary_terminated() && !was_terminated {
-                fork.beta *= initial.pdf().safe_div(lam.pdf());
-            }
-            if fork.depth == self.settings.max_depth || !b.flags().is_specular() {
-                break;
-            }
-            fork.depth += 1;
-            let w = -ray.d.normalize();
-            let (u, u2) = (sampler.get_1d(), sampler.get_2d());
-            match b.sample_f(w, u, u2, mode, SampleFlags::ALL) {
-                Some(s) if s.is_specular() => {
-                    self.scatter(&hit, &b, w, &s, &mut fork);
-                    ray = hit.spawn_ray(s.wi);
-                }
-                _ => break,
-            }
-        }
-        fork.l
+        // The first hit after `max_depth` scatterings still counts, as in
+        // the path loop.
+        let max_depth = self.settings.max_depth + 1;
+        subpath::delta_emission(ctx.scene, lambda, sampler, max_depth, start)
     }
 
     /// Russian roulette ([`Roulette::Throughput`]); returns false to stop.

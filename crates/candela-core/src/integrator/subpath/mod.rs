@@ -61,14 +61,17 @@
 //! into β (hero ×4, others 0, the same expectation), in [`Dispersion::Keep`]
 //! the caller's film divides by the changed wavelength densities instead.
 
+mod fork;
 mod start;
 mod vertex;
 
+use fork::fork_reflection;
+pub use fork::{delta_emission, fork_emission_after, forks_at};
 pub use start::{start_light_subpath, LightStart};
 pub use vertex::{adjoint_cos, dir, to_area, to_area_at, EndPoint, Vertex, VertexKind};
 
 use super::roulette::Roulette;
-use crate::bsdf::{BxdfFlags, SampleFlags, TransportMode};
+use crate::bsdf::{Bsdf, BsdfSample, SampleFlags, TransportMode};
 use crate::interaction::SurfaceInteraction;
 use crate::math::Ray;
 use crate::sampling::{PathRng, PdfArea, PdfSolidAngle};
@@ -349,54 +352,6 @@ where
     End::Ended
 }
 
-/// Walks the reflection alone from `v` with a [`Visitor::fork`] of the
-/// visitor when it forks there, joins what the fork found, and marks `st`
-/// as forked here (module doc, "Splitting").
-fn fork_reflection<R, V>(
-    fixed: &Fixed<'_>,
-    lambda: &SampledWavelengths,
-    rng: &mut R,
-    flow: Flow,
-    v: &Vertex,
-    st: &mut State,
-    visitor: &mut V,
-) where
-    R: PathRng + ?Sized,
-    V: Visitor<R>,
-{
-    let pair = BxdfFlags::SPECULAR | BxdfFlags::REFLECTION | BxdfFlags::TRANSMISSION;
-    if !V::FORKS || v.bsdf.as_ref().map(|b| b.flags()) != Some(pair) {
-        return;
-    }
-    let Some(mut branch) = visitor.fork(v) else {
-        return;
-    };
-    // No roulette: the fork's β starts at F times the walk's, which the
-    // walk's rule would read as a path hardly worth going on with.
-    let w = Walk {
-        dispersion: Dispersion::Fold,
-        roulette: None,
-        ..*fixed.w
-    };
-    let at_fork = Fixed {
-        scene: fixed.scene,
-        w: &w,
-        initial: *lambda,
-    };
-    let mut lambda_r = *lambda;
-    let mut st_r = State {
-        fork: true,
-        fork_emission: false,
-        ..st.clone()
-    };
-    let reflection = SampleFlags::REFLECTION;
-    if scatter(v, &w, flow, reflection, &mut st_r, &mut branch, rng).is_none() {
-        run(&at_fork, &mut lambda_r, rng, st_r, &mut branch);
-    }
-    visitor.join(branch);
-    st.forked_here = true;
-}
-
 /// Samples the BSDF at `v` and advances `st`; `Some` when the walk ends.
 fn scatter<R, V>(
     v: &Vertex,
@@ -436,7 +391,7 @@ where
         st.pdf_dir = PdfSolidAngle(0.0);
     }
     let forked = std::mem::take(&mut st.forked_here);
-    st.fork_emission = bs.is_specular() && (st.fork_emission || (forked && bs.is_reflection()));
+    st.fork_emission = fork_emission_after(st.fork_emission, forked, &bs);
     st.after_delta = bs.is_specular();
     st.scattered = true;
     st.any_non_specular |= !bs.is_specular();
@@ -465,8 +420,8 @@ where
 /// for the next vertex's conversion.
 fn report_densities<R, V>(
     v: &Vertex,
-    bsdf: &crate::bsdf::Bsdf,
-    bs: &crate::bsdf::BsdfSample,
+    bsdf: &Bsdf,
+    bs: &BsdfSample,
     mode: TransportMode,
     cos: f32,
     st: &mut State,
