@@ -10,7 +10,7 @@
 mod common;
 
 use candela_core::build::Overrides;
-use common::{render_str, stats};
+use common::{seeded_block_means, stats};
 
 const RES: usize = 32;
 const K: usize = 8;
@@ -45,17 +45,7 @@ Shape "trianglemesh" "point3 P" [-5 0 -5  5 0 -5  5 0 5  -5 0 5] "integer indice
 
 /// Block means of K renders with seeds 100…, as `[block][render]`.
 fn blocks(sampler: &str) -> Vec<Vec<f64>> {
-    let text = scene(sampler);
-    let renders: Vec<Vec<f64>> = (0..K)
-        .map(|k| {
-            let ov = Overrides {
-                seed: Some(100 + k as u64),
-                ..Default::default()
-            };
-            stats::block_means(&render_str(&text, &ov))
-        })
-        .collect();
-    stats::by_block(&renders)
+    seeded_block_means(&scene(sampler), &Overrides::default(), 100, K)
 }
 
 #[test]

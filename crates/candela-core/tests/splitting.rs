@@ -21,7 +21,7 @@
 mod common;
 
 use candela_core::build::Overrides;
-use common::{render_str, stats};
+use common::{seeded_block_means, stats};
 
 const K: usize = 8;
 
@@ -56,17 +56,11 @@ AttributeEnd
 
 /// Block means of K renders with seeds 100…, `[block][render]`.
 fn block_means(scene: &str, spp: u32) -> Vec<Vec<f64>> {
-    let renders: Vec<Vec<f64>> = (0..K)
-        .map(|k| {
-            let ov = Overrides {
-                spp: Some(spp),
-                seed: Some(100 + k as u64),
-                ..Default::default()
-            };
-            stats::block_means(&render_str(scene, &ov))
-        })
-        .collect();
-    stats::by_block(&renders)
+    let ov = Overrides {
+        spp: Some(spp),
+        ..Default::default()
+    };
+    seeded_block_means(scene, &ov, 100, K)
 }
 
 /// Blocks of 8×8 pixels, four by four; the glint is where the centre four

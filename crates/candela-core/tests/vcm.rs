@@ -13,7 +13,7 @@
 mod common;
 
 use candela_core::build::Overrides;
-use common::{render_str, stats};
+use common::{render_str, seeded_block_means, stats};
 
 const K: usize = 8;
 
@@ -46,18 +46,12 @@ fn block_means(scene: &str, spp: u32) -> Vec<Vec<f64>> {
 
 /// [`block_means`] of the `cropwindow` part of the film.
 fn block_means_in(scene: &str, spp: u32, cropwindow: Option<[f32; 4]>) -> Vec<Vec<f64>> {
-    let renders: Vec<Vec<f64>> = (0..K)
-        .map(|k| {
-            let ov = Overrides {
-                spp: Some(spp),
-                seed: Some(100 + k as u64),
-                cropwindow,
-                ..Default::default()
-            };
-            stats::block_means(&render_str(scene, &ov))
-        })
-        .collect();
-    stats::by_block(&renders)
+    let ov = Overrides {
+        spp: Some(spp),
+        cropwindow,
+        ..Default::default()
+    };
+    seeded_block_means(scene, &ov, 100, K)
 }
 
 fn vcm(mode: &str, radius: f32) -> String {

@@ -18,7 +18,7 @@
 mod common;
 
 use candela_core::build::Overrides;
-use common::{render_str, stats};
+use common::{seeded_block_means, stats};
 
 const K: usize = 6;
 
@@ -54,17 +54,11 @@ AttributeEnd
 
 /// Block means of K renders with seeds 300…, `[block][render]`.
 fn block_means(text: &str, spp: u32) -> Vec<Vec<f64>> {
-    let renders: Vec<Vec<f64>> = (0..K)
-        .map(|k| {
-            let ov = Overrides {
-                spp: Some(spp),
-                seed: Some(300 + k as u64),
-                ..Default::default()
-            };
-            stats::block_means(&render_str(text, &ov))
-        })
-        .collect();
-    stats::by_block(&renders)
+    let ov = Overrides {
+        spp: Some(spp),
+        ..Default::default()
+    };
+    seeded_block_means(text, &ov, 300, K)
 }
 
 fn agree(camera: &str, what: &str) {

@@ -16,6 +16,23 @@ pub fn render_str(text: &str, ov: &Overrides) -> RgbImage {
     render_at(text, Path::new("test.pbrt"), ov).0
 }
 
+/// Block means (`stats::block_means`) of `k` renders of `text` with the
+/// overrides `ov` and seeds `first_seed`, `first_seed` + 1, …, as
+/// `[block][render]` (`stats::by_block`): K independent estimates of every
+/// block, for `stats::assert_blocks_agree`.
+pub fn seeded_block_means(text: &str, ov: &Overrides, first_seed: u64, k: usize) -> Vec<Vec<f64>> {
+    let renders: Vec<Vec<f64>> = (0..k as u64)
+        .map(|i| {
+            let ov = Overrides {
+                seed: Some(first_seed + i),
+                ..ov.clone()
+            };
+            stats::block_means(&render_str(text, &ov))
+        })
+        .collect();
+    stats::by_block(&renders)
+}
+
 /// Renders scene text as if read from `path` (relative files resolve beside
 /// it); returns the image and the build warnings.
 pub fn render_at(text: &str, path: &Path, ov: &Overrides) -> (RgbImage, Vec<String>) {
