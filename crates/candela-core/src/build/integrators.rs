@@ -515,6 +515,9 @@ fn vcm_settings(ck: &Check<'_>, c: &Common) -> Result<VcmSettings, BuildError> {
             Domain::Closed(0.0, 1.0),
         )?,
         split_specular: split_specular(ck)?,
+        local_radius: ck
+            .params
+            .get_bool("localradius", VcmSettings::default().local_radius)?,
     })
 }
 

@@ -5,7 +5,6 @@
 
 use super::camera::CameraPass;
 use super::merge::MergeGrid;
-use super::mis::Factors;
 use super::variance::{ByLength, LtWeights};
 use super::VcmIntegrator;
 use crate::film::{FilmTile, PassSplats};
@@ -38,9 +37,9 @@ impl VcmIntegrator {
         record: bool,
     ) -> Option<Iteration> {
         let t = self.techniques;
-        let radius = self.radius(pass);
         let n_light = self.light_paths(ctx) as f32;
-        let f = Factors::new(radius, n_light, t.connect, t.merge, self.direct_merges());
+        let f = self.factors(pass, n_light);
+        let radius = f.grid_radius();
         // One wavelength group: every light and camera path of the iteration
         // shares its wavelengths, so merged power stays spectral.
         let lambda = *pass_wavelengths(self.settings.seed, pass, 1).group(0);
@@ -61,8 +60,7 @@ impl VcmIntegrator {
         let cp = CameraPass {
             light: &light,
             grid: grid.as_ref(),
-            radius,
-            f,
+            ff: f,
             lambda,
             time,
             pass,

@@ -19,6 +19,7 @@
 //! faulted pages, was a serial memcpy of ~12 MB per iteration at 128².
 
 use super::densities::light_densities;
+use super::field::FactorField;
 use super::mis::{thin, weight, Deferred, DirectMerges, Factors, Partial};
 use super::variance::LtWeights;
 use super::{Techniques, VcmIntegrator};
@@ -55,6 +56,8 @@ pub struct LightVertex {
     pub beta: SampledSpectrum,
     /// Its partial MIS quantities.
     pub mis: Partial,
+    /// The MIS factors at its position (a radius field's, [`super::field`]).
+    pub f: Factors,
     /// Surface vertices of the light subpath up to this one.
     pub depth: u32,
     /// Its subpath kept only the hero wavelength (dispersion, folded into β).
@@ -229,7 +232,7 @@ impl VcmIntegrator {
         pass: u64,
         lambda: &SampledWavelengths,
         time: f32,
-        f: &Factors,
+        f: &FactorField<'_>,
         lt: Option<&LtWeights>,
     ) -> Option<LightPaths> {
         let n = self.light_paths(ctx);
@@ -267,7 +270,7 @@ impl VcmIntegrator {
         i: u64,
         lambda: &SampledWavelengths,
         time: f32,
-        f: &Factors,
+        f: &FactorField<'_>,
         out: &mut Vec<LightVertex>,
         buf: Option<(&mut SplatBuffer, &LtWeights)>,
     ) {
@@ -291,7 +294,8 @@ impl VcmIntegrator {
         let by_area = scene.light(id).samples_li_by_area();
         let nee_from = (!by_area).then_some((id, ls.vertex.it));
         let direct = if nee_from.is_some() { 1.0 } else { direct };
-        let mis = Partial::light(direct, emission, cos, ty.is_delta(), f);
+        let f_prev = f.at(ls.vertex.p());
+        let mis = Partial::light(direct, emission, cos, ty.is_delta(), &f_prev);
         if let (true, Some(buf)) = (self.techniques.light_only, buf.as_deref_mut()) {
             self.splat_light_point(ctx, &ls.vertex, &ls, lambda, &mut rng, buf);
         }
@@ -306,6 +310,7 @@ impl VcmIntegrator {
             vcm: self,
             ctx,
             f,
+            f_prev,
             lambda,
             mis,
             prev: PrevVertex::of(&ls.vertex),
@@ -354,7 +359,9 @@ impl VcmIntegrator {
 struct LightVisitor<'a, 'b> {
     vcm: &'a VcmIntegrator,
     ctx: &'a RenderContext<'b>,
-    f: &'a Factors,
+    f: &'a FactorField<'a>,
+    /// The factors at the vertex reached last.
+    f_prev: Factors,
     lambda: &'a SampledWavelengths,
     mis: Partial,
     prev: PrevVertex,
@@ -394,15 +401,16 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
             // Leaving x_1, whether its merge exists waits for x_2 (module
             // doc of `mis`).
             let merge_here = self.f.merges_at(next_to_light, false);
+            // The merge at the vertex left has that vertex's η.
             let merge = self.mis.scatter(
                 s.delta,
                 s.pdf_fwd.0,
                 s.pdf_rev.0,
                 cos_out,
-                self.f,
+                &self.f_prev,
                 merge_here,
             );
-            let waits = next_to_light && self.f.direct == DirectMerges::AfterSpecular;
+            let waits = next_to_light && self.f.direct() == DirectMerges::AfterSpecular;
             self.first = waits.then_some(merge);
         }
         let d2 = if self.prev.at_infinity {
@@ -422,6 +430,7 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
             first.hit(cos_in);
         }
         self.prev = PrevVertex::of(v);
+        self.f_prev = self.f.at(v.p());
         let Some(bsdf) = &v.bsdf else {
             return Flow::Continue;
         };
@@ -437,6 +446,7 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
                 bsdf: *bsdf,
                 beta: v.beta,
                 mis: self.mis,
+                f: self.f_prev,
                 depth: v.depth,
                 terminated: lam.secondary_terminated(),
             });
@@ -497,7 +507,9 @@ impl LightVisitor<'_, '_> {
             let c = self
                 .lt
                 .map_or(1.0, |lt| LtWeights::at(lt.row(cs.p_raster), v.depth));
-            let w_light = self.mis.connect_weight(pdf_cam_a, pdf_rev, self.f, merge);
+            let w_light = self
+                .mis
+                .connect_weight(pdf_cam_a, pdf_rev, &self.f_prev, merge);
             if w_light == 0.0 {
                 1.0
             } else {

@@ -9,7 +9,12 @@
 //! quantities and the densities next to the join. With η_VCM = π r² N_light
 //! (eq. 20, n_VC = 1, n_VM = N_light), merging enters through
 //! `vm = mis(η_VCM)` and connections through `vc = mis(1/η_VCM)`; a mode
-//! without merges sets `vm = 0`, one without connections `vc = 0`.
+//! without merges sets `vm = 0`, one without connections `connect = 0`.
+//! η may differ from vertex to vertex (a radius field, [`super::field`]):
+//! each merge technique's term carries the η of its own vertex, so d_VM is
+//! kept without the evaluated merge's 1/η and [`Partial::merge_weight`]
+//! multiplies it in with the factors of the merge's vertex; with one η
+//! everywhere this is SmallVCM's recursion term for term.
 //!
 //! Densities are per unit solid angle at the sampling vertex except where a
 //! name ends in `_a` (per unit area). The cosines of the area conversions are
@@ -94,13 +99,19 @@ impl DirectMerges {
     pub const NAMES: &'static str = "always, afterspecular, never";
 }
 
-/// The per-iteration constants of eq. 20 and the merge normalisation.
+/// The constants of eq. 20 and the merge normalisation at one vertex: with
+/// a radius field ([`super::field`]) η_VCM differs from vertex to vertex,
+/// and each merge technique of a path uses the η of its own vertex.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Factors {
-    /// mis(η_VCM) when merging is on, else 0.
+    /// mis(η_VCM) when merging is on, else 0: a merge at this vertex
+    /// relative to a connection.
     pub vm: f32,
-    /// mis(1/η_VCM) when connecting is on, else 0.
+    /// mis(1/η_VCM): a connection relative to a merge at this vertex (only
+    /// merge weights use it).
     pub vc: f32,
+    /// 1 when connecting is on, else 0.
+    pub connect: f32,
     /// 1/η_VCM = 1/(π r² N_light), the merge kernel's normalisation.
     pub merge_norm: f32,
     /// Which merges next to the light exist (module doc).
@@ -114,7 +125,8 @@ impl Factors {
         let eta = std::f32::consts::PI * r * r * n_light;
         Self {
             vm: if merge { mis(eta) } else { 0.0 },
-            vc: if connect { mis(1.0 / eta) } else { 0.0 },
+            vc: mis(1.0 / eta),
+            connect: if connect { 1.0 } else { 0.0 },
             merge_norm: 1.0 / eta,
             direct,
         }
@@ -141,7 +153,9 @@ pub struct Partial {
     pub d_vcm: f32,
     /// Connections only.
     pub d_vc: f32,
-    /// Merges only.
+    /// Merges only, without the evaluated merge's own 1/η (its vertex's
+    /// [`Factors::vc`] multiplies it in [`Partial::merge_weight`]), so that
+    /// each term keeps the η of the vertex it belongs to.
     pub d_vm: f32,
 }
 
@@ -152,7 +166,7 @@ pub struct Partial {
 pub struct Deferred {
     /// The merge's term of d_VC.
     pub vc: f32,
-    /// The merge's term of d_VM.
+    /// The merge's term of d_VM (without 1/η, as d_VM).
     pub vm: f32,
     /// d_VC without the merge's term.
     pub d_vc_without: f32,
@@ -183,7 +197,7 @@ impl Partial {
         Self {
             d_vcm: mis(direct / emission),
             d_vc,
-            d_vm: d_vc * f.vc,
+            d_vm: d_vc * f.connect,
         }
     }
 
@@ -277,13 +291,13 @@ impl Partial {
         let rev = mis(pdf_rev);
         let merge = Deferred {
             vc: source * g * f.vm,
-            vm: source * g,
+            vm: source * g * f.vm,
             d_vc_without: g * (self.d_vc * rev + self.d_vcm),
         };
         *self = Self {
             d_vcm: source * mis(1.0 / pdf_fwd),
             d_vc: merge.d_vc_without,
-            d_vm: g * (self.d_vm * rev + self.d_vcm * f.vc),
+            d_vm: g * (self.d_vm * rev + self.d_vcm * f.connect),
         };
         if merge_here {
             self.add(&merge);
@@ -308,9 +322,10 @@ impl Partial {
     }
 
     /// The partial weight of this subpath in a merge whose other side would
-    /// have sampled the direction with `pdf` [eqs. 38, 39].
+    /// have sampled the direction with `pdf` [eqs. 38, 39], `f` the
+    /// factors at the merge's (camera) vertex.
     pub fn merge_weight(&self, pdf: f32, f: &Factors) -> f32 {
-        self.d_vcm * f.vc + self.d_vm * mis(pdf)
+        f.vc * (self.d_vcm * f.connect + self.d_vm * mis(pdf))
     }
 
     /// The camera subpath's partial weight when it hits a light whose

@@ -66,7 +66,9 @@ struct Path {
     cam: (f32, f32),
     pdf_pixel: f32,
     n_light: f32,
-    radius: f32,
+    /// Per vertex 0..=m: the merge radius there (a radius field,
+    /// [`super::field`]; on half the paths one radius for all).
+    radius: Vec<f32>,
     /// Light tracing's variance factor c on this path.
     lt_c: f32,
 }
@@ -123,7 +125,11 @@ impl Path {
             cam: (uniform(rng, 0.5, 5.0), uniform(rng, 0.2, 1.0)),
             pdf_pixel: uniform(rng, 1e3, 1e5),
             n_light: uniform(rng, 1e3, 1e5),
-            radius: uniform(rng, 0.002, 0.05),
+            radius: if rng.u1() < 0.5 {
+                vec![uniform(rng, 0.002, 0.05); m + 1]
+            } else {
+                (0..=m).map(|_| uniform(rng, 0.002, 0.05)).collect()
+            },
             lt_c: if rng.u1() < 0.25 {
                 1.0
             } else {
@@ -199,7 +205,7 @@ enum Technique {
 /// Every possible technique's density with its sample count (eq. 20).
 fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
     let m = p.m();
-    let eta = std::f64::consts::PI * (p.radius as f64).powi(2) * p.n_light as f64;
+    let eta = |i: usize| std::f64::consts::PI * (p.radius[i] as f64).powi(2) * p.n_light as f64;
     let light = |s: usize| (0..s).map(|k| p.pl(k)).product::<f64>();
     let camera = |from: usize| (from..=m).map(|k| p.pe(k)).product::<f64>();
     let mut out = Vec::new();
@@ -227,7 +233,7 @@ fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
     };
     for i in 1..=m {
         if !p.specular(i) && (i >= 2 || merge_at_1) {
-            out.push((Technique::Merge(i), light(i + 1) * camera(i) * eta));
+            out.push((Technique::Merge(i), light(i + 1) * camera(i) * eta(i)));
         }
     }
     out
@@ -235,7 +241,7 @@ fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
 
 /// The light subpath's quantities at x_1 ..= x_m, built as light.rs
 /// (`trace_light`, `vertex`) builds them.
-fn light_states(p: &Path, f: &Factors) -> Vec<Partial> {
+fn light_states(p: &Path, f: &[Factors]) -> Vec<Partial> {
     let m = p.m();
     let (direct, emission, cos_light) = p.light_densities();
     let seg = |k: usize| p.seg[k];
@@ -247,7 +253,7 @@ fn light_states(p: &Path, f: &Factors) -> Vec<Partial> {
         emission,
         cos_light,
         point,
-        f,
+        &f[0],
     );
     let mut first: Option<Deferred> = None;
     for (k, state) in lp.iter_mut().enumerate().skip(1) {
@@ -258,16 +264,16 @@ fn light_states(p: &Path, f: &Factors) -> Vec<Partial> {
                 }
             }
             let next_to_light = k - 1 == 1;
-            let merge_here = f.merges_at(next_to_light, false);
+            let merge_here = f[0].merges_at(next_to_light, false);
             let t = st.scatter(
                 p.delta[k - 1],
                 p.pl_dir[k - 1],
                 p.pe_dir[k - 1],
                 seg(k - 1).1,
-                f,
+                &f[k - 1],
                 merge_here,
             );
-            if next_to_light && !merge_here && f.merges_at(true, true) {
+            if next_to_light && !merge_here && f[0].merges_at(true, true) {
                 first = Some(t);
             }
         }
@@ -291,7 +297,7 @@ fn light_states(p: &Path, f: &Factors) -> Vec<Partial> {
 /// The light subpath's quantities at x_1 ..= x_m, the camera subpath's at
 /// x_m ..= x_0 and the camera's for its emission weight at x_0, built as
 /// light.rs and camera.rs build them.
-fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial) {
+fn subpath_states(p: &Path, f: &[Factors]) -> (Vec<Partial>, Vec<Partial>, Partial) {
     let (m, seg) = (p.m(), |k: usize| p.seg[k]);
     let lp = light_states(p, f);
     // Camera subpath: the state at x_m ..= x_1, then at the light
@@ -310,7 +316,7 @@ fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial
             p.pe_dir[k + 1],
             p.pl_dir[k + 1],
             seg(k).2,
-            f,
+            &f[k + 1],
         );
         last_after_delta = arrived_delta;
         arrived_delta = p.delta[k + 1];
@@ -321,7 +327,7 @@ fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial
         }
         cp[k] = st.with_lt(c);
     }
-    let emitted = if f.merges_at(true, last_after_delta) {
+    let emitted = if f[0].merges_at(true, last_after_delta) {
         cp[0]
     } else {
         Partial {
@@ -333,7 +339,7 @@ fn subpath_states(p: &Path, f: &Factors) -> (Vec<Partial>, Vec<Partial>, Partial
 }
 
 /// The recursive weight of every technique, driven as the two passes do.
-fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
+fn recursive(p: &Path, f: &[Factors]) -> Vec<(Technique, f32)> {
     let m = p.m();
     let (direct, emission, cos_light) = p.light_densities();
     let seg = |k: usize| p.seg[k];
@@ -358,8 +364,8 @@ fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
         };
         let w_light = mis(bsdf_dir * cos_light * inv_d2 / direct);
         let ratio = emission * cos_recv * inv_d2 / direct;
-        let merge = f.merges_at(true, x1_after_delta);
-        let w_cam = cp[1].connect_weight(ratio, p.pl_dir[1], f, merge);
+        let merge = f[0].merges_at(true, x1_after_delta);
+        let w_cam = cp[1].connect_weight(ratio, p.pl_dir[1], &f[1], merge);
         out.push((Technique::Connect(1), weight(w_light, w_cam)));
     }
     for s in 2..=m {
@@ -370,24 +376,25 @@ fn recursive(p: &Path, f: &Factors) -> Vec<(Technique, f32)> {
         let (d2, cos_l, cos_c) = seg(s - 1);
         let cam_dir_a = p.pe_dir[s] * cos_l / d2;
         let light_dir_a = p.pl_dir[s - 1] * cos_c / d2;
-        let merge_light = f.merges_at(s - 1 == 1, false);
-        let w_light = lp[s - 1].connect_weight(cam_dir_a, p.pe_dir[s - 1], f, merge_light);
-        let w_cam = cp[s].connect_weight(light_dir_a, p.pl_dir[s], f, true);
+        let merge_light = f[0].merges_at(s - 1 == 1, false);
+        let w_light = lp[s - 1].connect_weight(cam_dir_a, p.pe_dir[s - 1], &f[s - 1], merge_light);
+        let w_cam = cp[s].connect_weight(light_dir_a, p.pl_dir[s], &f[s], true);
         out.push((Technique::Connect(s), weight(w_light, w_cam)));
     }
     if !p.delta[m] {
         // Light tracing at x_m (light.rs `connect_to_camera`).
         let pdf_cam_a = p.pdf_pixel * p.cam.1 / (p.cam.0 * p.n_light);
-        let merge = f.merges_at(m == 1, false);
-        let w_light = lp[m].connect_weight(pdf_cam_a, p.pe_dir[m], f, merge) / p.lt_c;
+        let merge = f[0].merges_at(m == 1, false);
+        let w_light = lp[m].connect_weight(pdf_cam_a, p.pe_dir[m], &f[m], merge) / p.lt_c;
         let w = weight(w_light, 0.0);
         out.push((Technique::Connect(m + 1), w));
     }
     for i in 1..=m {
-        if !p.delta[i] && f.merges_at(i == 1, x1_after_delta) {
-            // camera.rs `merge`: the light vertex's wo is the incident direction.
-            let w_light = lp[i].merge_weight(p.pe_dir[i], f);
-            let w_cam = cp[i].merge_weight(p.pl_dir[i], f);
+        if !p.delta[i] && f[0].merges_at(i == 1, x1_after_delta) {
+            // camera.rs `merge`: the light vertex's wo is the incident
+            // direction; the factors are those at the merge's vertex.
+            let w_light = lp[i].merge_weight(p.pe_dir[i], &f[i]);
+            let w_cam = cp[i].merge_weight(p.pl_dir[i], &f[i]);
             out.push((Technique::Merge(i), weight(w_light, w_cam)));
         }
     }
@@ -415,7 +422,11 @@ impl Mismatch {
 /// Compares the two, with the merges next to the light `direct`; None
 /// when the path has no technique.
 fn compare(truth: &Path, given: &Path, direct: DirectMerges) -> Option<Mismatch> {
-    let f = Factors::new(given.radius, given.n_light, true, true, direct);
+    let f: Vec<Factors> = given
+        .radius
+        .iter()
+        .map(|&r| Factors::new(r, given.n_light, true, true, direct))
+        .collect();
     let brute = brute_force(truth, direct);
     let total: f64 = brute.iter().map(|(_, q)| q * q).sum();
     if brute.is_empty() || total == 0.0 {

@@ -130,6 +130,16 @@
 //! targets of the benchmark (`bench/vcm_equal_time.py`), where K = 2
 //! missed on the Cornell box and K = 4 on the pool.
 //!
+//! **Local radius** (`"bool localradius"`, true by default; only without a
+//! written `radius`): the same rule applied per cell of space instead of
+//! once for the image, from four pilot light passes ([`field`]): small
+//! where light vertices are dense (a caustic's lines), large where they are
+//! sparse, each merge with its own vertex's η in the MIS weights.
+//! Measured on the pool at 8 s, two seeds: relMSE 0.0104 / 0.0101 against
+//! 0.0134 / 0.0140 with one radius; at equal iterations (90) on the
+//! Cornell box 0.00090 / 0.00085 / 0.00087 against 0.00092 / 0.00087 /
+//! 0.00088, where the lookups cost ~5 % of the time.
+//!
 //! **Light tracing on direct light (a limit of density-based weights).** The
 //! power heuristic weighs techniques by density alone. On the Cornell box
 //! (128², one light path per pixel) about 1.7 light subpaths land in a
@@ -172,6 +182,7 @@
 
 mod camera;
 pub mod densities;
+pub mod field;
 mod iteration;
 pub mod light;
 mod merge;
@@ -188,6 +199,7 @@ use crate::integrator::lt_weights::{Pilot, PILOT_PASSES};
 use crate::integrator::sppm::ppm_radius2;
 use crate::sampling::hash_u64s;
 use crate::sampling::PdfSolidAngle;
+use field::{FactorField, RadiusField};
 use light::LightVertex;
 use mis::DirectMerges;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -341,6 +353,9 @@ pub struct VcmSettings {
     /// there to count the emission its reflection reaches (`splitspecular`;
     /// module doc of [`crate::integrator::subpath`], "Splitting").
     pub split_specular: bool,
+    /// Without a written `radius`, the merge radius varies over the scene
+    /// with the light vertices' density (`localradius`; [`field`]).
+    pub local_radius: bool,
 }
 
 impl Default for VcmSettings {
@@ -359,6 +374,7 @@ impl Default for VcmSettings {
             variance_lt: true,
             join_roulette: 0.1,
             split_specular: true,
+            local_radius: true,
         }
     }
 }
@@ -374,8 +390,8 @@ pub struct VcmIntegrator {
     /// Storage reused from one iteration to the next.
     pools: Pools,
     /// The first iteration's radius once known (the written one, or the
-    /// pilot's).
-    radius0: OnceLock<f32>,
+    /// pilot's), and the pilot's radius field (`localradius`).
+    radius0: OnceLock<(f32, Option<RadiusField>)>,
     /// Light tracing's factors in the weights, and their pilot ([`variance`]).
     pilot: Pilot,
 }
@@ -403,15 +419,28 @@ impl VcmIntegrator {
     /// The first iteration's radius: the written one, or the light vertices'
     /// density radius of a pilot pass ([`pilot`]); `None` if cancelled.
     fn radius0(&self, ctx: &RenderContext<'_>) -> Option<f32> {
-        if let Some(&r) = self.radius0.get() {
-            return Some(r);
+        if let Some((r, _)) = self.radius0.get() {
+            return Some(*r);
         }
         let r = if self.settings.radius_from_density && self.techniques.merge {
             pilot::density_radius(self, ctx, self.settings.radius)?
         } else {
-            self.settings.radius
+            (self.settings.radius, None)
         };
-        Some(*self.radius0.get_or_init(|| r))
+        Some(self.radius0.get_or_init(|| r).0)
+    }
+
+    /// The MIS factors and merge radii of (0-based) pass `pass` with
+    /// `n_light` light paths: from the radius field where there is one
+    /// ([`field`]), else uniform at [`VcmIntegrator::radius`].
+    fn factors(&self, pass: u64, n_light: f32) -> FactorField<'_> {
+        let t = self.techniques;
+        let r = self.radius(pass);
+        let f = FactorField::uniform(r, n_light, t.connect, t.merge, self.direct_merges());
+        match self.radius0.get() {
+            Some((r0, Some(field))) => FactorField::of_field(field, r / r0, r, f),
+            _ => f,
+        }
     }
 
     /// Which merges at a vertex next to the light are a technique: the
@@ -436,7 +465,7 @@ impl VcmIntegrator {
     /// The merge radius of (0-based) pass `pass` (before the first pass of
     /// a density-derived radius: from the footprint default).
     pub fn radius(&self, pass: u64) -> f32 {
-        let r0 = *self.radius0.get().unwrap_or(&self.settings.radius) as f64;
+        let r0 = self.radius0.get().map_or(self.settings.radius, |r| r.0) as f64;
         (r0 * r0 * ppm_radius2(pass + 1, self.settings.alpha as f64)).sqrt() as f32
     }
 

@@ -56,13 +56,15 @@
 //! that missed its target. The other scenes checked are above 2 footprints
 //! already.
 
+use super::field::{cell_key, FactorField, RadiusField, FIELD_PASSES};
 use super::light::LightVertex;
-use super::mis::{DirectMerges, Factors};
+use super::mis::DirectMerges;
 use super::VcmIntegrator;
 use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::RenderContext;
 use crate::math::Vec3;
 use crate::spatial::HashGrid;
+use std::collections::HashMap;
 use std::sync::atomic::AtomicU64;
 
 /// Other light vertices the default radius's disk holds around the median
@@ -86,28 +88,50 @@ const PROBE_DOUBLINGS: u32 = 4;
 /// Most vertices the median is taken over.
 const QUERIES: usize = 8192;
 
+/// Most vertices the radius field counts around.
+const FIELD_QUERIES: usize = 65536;
+
 /// The pilot's pass index: no rendered pass has it.
 const PILOT_PASS: u64 = u64::MAX;
 
 /// The merge radius of the first iteration for a render whose pixel
-/// footprint radius is `footprint` (module docs); `None` if the render was
-/// cancelled.
+/// footprint radius is `footprint` (module docs), and with `localradius`
+/// the radius field around it ([`super::field`]); `None` if the render
+/// was cancelled.
 pub(super) fn density_radius(
     vcm: &VcmIntegrator,
     ctx: &RenderContext<'_>,
     footprint: f32,
-) -> Option<f32> {
+) -> Option<(f32, Option<RadiusField>)> {
+    let mut points = pilot_points(vcm, ctx, footprint, PILOT_PASS)?;
+    let r = radius_for_neighbours(&points, footprint);
+    if !vcm.settings.local_radius || points.is_empty() {
+        return Some((r, None));
+    }
+    for k in 1..FIELD_PASSES {
+        points.extend(pilot_points(vcm, ctx, footprint, PILOT_PASS - k)?);
+    }
+    Some((r, Some(field_for(&points, r, FIELD_PASSES, footprint))))
+}
+
+/// The positions of the merging vertices of the pilot light pass `pass`.
+fn pilot_points(
+    vcm: &VcmIntegrator,
+    ctx: &RenderContext<'_>,
+    footprint: f32,
+    pass: u64,
+) -> Option<Vec<Vec3>> {
     let n_light = vcm.light_paths(ctx) as f32;
-    let f = Factors::new(footprint, n_light, false, true, DirectMerges::Always);
-    let lambda = *pass_wavelengths(vcm.settings.seed, PILOT_PASS, 1).group(0);
-    let time = vcm.time(ctx, PILOT_PASS);
+    let f = FactorField::uniform(footprint, n_light, false, true, DirectMerges::Always);
+    let lambda = *pass_wavelengths(vcm.settings.seed, pass, 1).group(0);
+    let time = vcm.time(ctx, pass);
     // Its own work counter: the pass's progress counts rendered paths only.
     let work = AtomicU64::new(0);
     let pilot = RenderContext {
         work: &work,
         ..*ctx
     };
-    let light = vcm.light_pass(&pilot, PILOT_PASS, &lambda, time, &f, None)?;
+    let light = vcm.light_pass(&pilot, pass, &lambda, time, &f, None)?;
     // The vertices that merge count: those next to the light only if they
     // all do (module doc of `mis`: by default only behind specular ones).
     let all = vcm.direct_merges() == DirectMerges::Always;
@@ -118,7 +142,39 @@ pub(super) fn density_radius(
         .flat_map(|c| c.iter().filter(merges).map(|v| v.p()))
         .collect();
     light.recycle(&vcm.pools.chunks);
-    Some(radius_for_neighbours(&points, footprint))
+    Some(points)
+}
+
+/// The radius field ([`super::field`]) of `points`, the merging vertices
+/// of `passes` light passes, with cells of side `r_g` (the global default
+/// radius) and radii within the footprint bounds.
+pub fn field_for(points: &[Vec3], r_g: f32, passes: u64, footprint: f32) -> RadiusField {
+    let (lo, hi) = (MIN_FOOTPRINTS * footprint, MAX_FOOTPRINTS * footprint);
+    let grid = HashGrid::build(points, r_g);
+    let stride = points.len().div_ceil(FIELD_QUERIES).max(1);
+    // Per cell: the sum of the neighbour counts and the vertices counted.
+    let mut sums: HashMap<[i32; 3], (f64, u32)> = HashMap::new();
+    for &p in points.iter().step_by(stride) {
+        let mut c = 0u32;
+        grid.for_each_within(p, r_g, |_, _| c += 1);
+        let e = sums.entry(cell_key(p, 1.0 / r_g)).or_insert((0.0, 0));
+        e.0 += f64::from(c.saturating_sub(1));
+        e.1 += 1;
+    }
+    let k = f64::from(TARGET_NEIGHBOURS) * passes as f64;
+    let cells: Vec<([i32; 3], f32)> = sums
+        .into_iter()
+        .map(|(key, (sum, n))| {
+            let mean = sum / f64::from(n);
+            let r = if mean > 0.0 {
+                (f64::from(r_g) * (k / mean).sqrt()) as f32
+            } else {
+                hi
+            };
+            (key, r.clamp(lo, hi))
+        })
+        .collect();
+    RadiusField::new(r_g, &cells, hi)
 }
 
 /// The radius whose disk holds [`TARGET_NEIGHBOURS`] other points around

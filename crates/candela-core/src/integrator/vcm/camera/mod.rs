@@ -36,6 +36,7 @@
 mod next_event;
 
 use super::densities::light_densities;
+use super::field::FactorField;
 use super::light::{LightPaths, LightVertex, PrevVertex};
 use super::merge::{MergeGrid, Photon};
 use super::mis::{thin, weight, CameraDeferred, CameraPartial, Factors, Partial};
@@ -65,10 +66,8 @@ pub(super) struct CameraPass<'a> {
     pub light: &'a LightPaths,
     /// Grid over `light.vertices` as photons (merging modes).
     pub grid: Option<&'a MergeGrid>,
-    /// The merge radius.
-    pub radius: f32,
-    /// MIS constants.
-    pub f: Factors,
+    /// MIS constants and merge radii, everywhere.
+    pub ff: FactorField<'a>,
     /// The iteration's wavelengths.
     pub lambda: SampledWavelengths,
     /// The iteration's time.
@@ -148,6 +147,7 @@ impl VcmIntegrator {
             vertices: 0,
             specular_fork: false,
             nee_ctx: LightSampleContext::at_point(ray.o),
+            f_here: cp.ff.at(ray.o),
             l: SampledSpectrum::zero(),
             by_length: [0.0; LENGTHS + 1],
         };
@@ -206,6 +206,9 @@ struct CameraVisitor<'a, 'b> {
     /// Where next-event estimation at the vertex left last would have
     /// sampled a light from (its emission weight, [`nee_area_density`]).
     nee_ctx: LightSampleContext,
+    /// The MIS factors at the current vertex (at the one left last until
+    /// the pending scattering is applied).
+    f_here: Factors,
     l: SampledSpectrum,
     /// `l` split by path length, when `cp.record`.
     by_length: ByLength,
@@ -234,6 +237,7 @@ impl Visitor<Sampler> for CameraVisitor<'_, '_> {
         rng: &mut Sampler,
     ) -> Flow {
         self.apply_scatter(v.wo.dot(self.prev.n).abs());
+        self.f_here = self.cp.ff.at(v.p());
         let d2 = (v.p() - self.prev.p).length_squared();
         let cos_in = v.wo.dot(v.it.n).abs();
         self.mis.hit(d2, cos_in);
@@ -324,7 +328,7 @@ impl CameraVisitor<'_, '_> {
     /// the terms of a merge at the vertex left (module doc of [`super::mis`]).
     fn apply_scatter(&mut self, cos_out: f32) {
         let Some(s) = self.pending.take() else { return };
-        let f = &self.cp.f;
+        let f = &self.f_here;
         self.last = self
             .mis
             .scatter(s.delta, s.pdf_fwd.0, s.pdf_rev.0, cos_out, f);
@@ -356,7 +360,7 @@ impl CameraVisitor<'_, '_> {
             return if self.specular { 1.0 } else { 0.0 };
         }
         let mut mis = self.partial(k);
-        if !self.cp.f.merges_at(true, self.last_after_delta) {
+        if !self.cp.ff.merges_at(true, self.last_after_delta) {
             mis.d_vc = self.last.d_vc_without(LtWeights::at(self.lt_row, k));
         }
         weight(0.0, mis.emission_weight(direct, emission))
@@ -462,14 +466,19 @@ impl CameraVisitor<'_, '_> {
         let (light_dir, light_rev) = lv.pdfs(&light);
         let cam_dir_a = cam_dir.0 * w.dot(lv.it.n).abs() / d2;
         let light_dir_a = light_dir * w.dot(v.it.n).abs() / d2;
-        let f = &self.cp.f;
-        // Merges at either end: not next to the light at the camera's; at a
-        // light vertex x_1 its camera-side neighbour is v, not specular.
-        let merge_light = f.merges_at(lv.depth == 1, false);
-        let w_light = lv.mis.connect_weight(cam_dir_a, light_rev, f, merge_light);
-        let w_cam =
-            self.partial(v.depth + lv.depth)
-                .connect_weight(light_dir_a, cam_rev.0, f, true);
+        // Merges at either end, each with its own vertex's η: not next to
+        // the light at the camera's; at a light vertex x_1 its camera-side
+        // neighbour is v, not specular.
+        let merge_light = self.cp.ff.merges_at(lv.depth == 1, false);
+        let w_light = lv
+            .mis
+            .connect_weight(cam_dir_a, light_rev, &lv.f, merge_light);
+        let w_cam = self.partial(v.depth + lv.depth).connect_weight(
+            light_dir_a,
+            cam_rev.0,
+            &self.f_here,
+            true,
+        );
         let mw = weight(w_light, w_cam);
         (mw != 0.0).then(|| (unfold(c * mw, terminated, lv.terminated), mw))
     }
@@ -478,12 +487,15 @@ impl CameraVisitor<'_, '_> {
     fn merge(&mut self, v: &Vertex, cb: &Bsdf, terminated: bool) {
         let Some(grid) = self.cp.grid else { return };
         let max_depth = self.vcm.settings.max_depth;
-        let (f, ppm) = (&self.cp.f, self.vcm.techniques.ppm);
+        // The kernel and the weights of a merge are those of its camera
+        // vertex (module doc of [`super::field`]).
+        let (f, ppm) = (&self.f_here, self.vcm.techniques.ppm);
+        let radius = self.cp.ff.radius_at(v.p());
         // Light vertices next to the light merge here only where that merge
         // exists ([`Factors::merges_at`]); the rest always do. The grid
         // hands out the former only when asked to.
         let merge_direct = f.merges_at(true, self.arrived_delta);
-        let r2 = self.cp.radius * self.cp.radius;
+        let r2 = radius * radius;
         let x = Surfel {
             p: v.p(),
             n: v.it.n,
@@ -501,7 +513,7 @@ impl CameraVisitor<'_, '_> {
                 ph.depth + v.depth > max_depth + 1
             }
         };
-        grid.for_each_within(v.p(), self.cp.radius, merge_direct, |ph| {
+        grid.for_each_within(v.p(), radius, merge_direct, |ph| {
             if too_deep(ph) {
                 return;
             }

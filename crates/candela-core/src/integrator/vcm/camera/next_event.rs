@@ -56,10 +56,10 @@ impl CameraVisitor<'_, '_> {
         let w_light = mis(bsdf_dir * cos_light * inv_d2 / direct);
         let ratio = emission * cos_recv * inv_d2 / direct;
         // A merge at v, next to the light, exists after a specular vertex.
-        let merge = self.cp.f.merges_at(true, self.arrived_delta);
+        let merge = self.cp.ff.merges_at(true, self.arrived_delta);
         let w_cam = self
             .partial(v.depth)
-            .connect_weight(ratio, bsdf_rev, &self.cp.f, merge);
+            .connect_weight(ratio, bsdf_rev, &self.f_here, merge);
         self.add(v.depth, v.beta * ls.unweighted() * weight(w_light, w_cam));
     }
 }

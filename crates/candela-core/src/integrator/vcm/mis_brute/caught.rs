@@ -111,3 +111,29 @@ fn the_light_tracing_factor_is_applied() {
     );
     assert!(tried > 50 && caught == tried, "{caught}/{tried}");
 }
+
+/// With a radius field each merge technique has the η of its own vertex:
+/// giving the recursion one radius for the whole path (x_1's) where the
+/// radius at some other vertex differs from it by more than 30 % is caught
+/// on every path without specular vertices where the merges carry more
+/// than 1e-3 of the weight.
+#[test]
+fn each_merge_has_its_own_vertexs_radius() {
+    let differs = |p: &Path| {
+        p.radius[1..]
+            .iter()
+            .any(|&r| (r / p.radius[1] - 1.0).abs() > 0.3)
+    };
+    let (caught, tried) = catches(
+        1200,
+        DirectMerges::Always,
+        |p| p.m() >= 2 && differs(p),
+        |_, t| matches!(t, Technique::Merge(_)),
+        1e-3,
+        |p| Path {
+            radius: vec![p.radius[1]; p.radius.len()],
+            ..p.clone()
+        },
+    );
+    assert!(tried > 50 && caught == tried, "{caught}/{tried}");
+}
