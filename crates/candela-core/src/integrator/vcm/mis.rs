@@ -114,6 +114,8 @@ pub struct Factors {
     pub connect: f32,
     /// 1/η_VCM = 1/(π r² N_light), the merge kernel's normalisation.
     pub merge_norm: f32,
+    /// The merge radius r here.
+    pub radius: f32,
     /// Which merges next to the light exist (module doc).
     pub direct: DirectMerges,
 }
@@ -128,6 +130,7 @@ impl Factors {
             vc: mis(1.0 / eta),
             connect: if connect { 1.0 } else { 0.0 },
             merge_norm: 1.0 / eta,
+            radius: r,
             direct,
         }
     }

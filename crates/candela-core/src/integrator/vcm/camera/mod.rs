@@ -490,7 +490,7 @@ impl CameraVisitor<'_, '_> {
         // The kernel and the weights of a merge are those of its camera
         // vertex (module doc of [`super::field`]).
         let (f, ppm) = (&self.f_here, self.vcm.techniques.ppm);
-        let radius = self.cp.ff.radius_at(v.p());
+        let radius = f.radius;
         // Light vertices next to the light merge here only where that merge
         // exists ([`Factors::merges_at`]); the rest always do. The grid
         // hands out the former only when asked to.
