@@ -66,6 +66,8 @@ pub struct RadiusField {
     empty: f32,
     /// Largest radius anywhere.
     max: f32,
+    /// Smallest radius anywhere.
+    min: f32,
 }
 
 /// A key no cell has (coordinates beyond ±2³¹ are clamped below it).
@@ -89,6 +91,7 @@ impl RadiusField {
             radii: vec![empty; size],
             empty,
             max: empty,
+            min: empty,
         };
         for &(key, r) in cells {
             let mut slot = field.slot_of(key);
@@ -98,6 +101,7 @@ impl RadiusField {
             field.keys[slot] = key;
             field.radii[slot] = r;
             field.max = field.max.max(r);
+            field.min = field.min.min(r);
         }
         field
     }
@@ -137,6 +141,11 @@ impl RadiusField {
     /// The largest radius anywhere.
     pub fn max(&self) -> f32 {
         self.max
+    }
+
+    /// The smallest and the largest radius anywhere.
+    pub fn range(&self) -> (f32, f32) {
+        (self.min, self.max)
     }
 }
 
@@ -244,5 +253,6 @@ mod tests {
         }
         assert_eq!(field.at(Vec3::splat(100.0)), 0.25);
         assert_eq!(field.max(), 200.0);
+        assert_eq!(field.range(), (0.25, 200.0));
     }
 }

@@ -134,11 +134,11 @@
 //! written `radius`): the same rule applied per cell of space instead of
 //! once for the image, from four pilot light passes ([`field`]): small
 //! where light vertices are dense (a caustic's lines), large where they are
-//! sparse, each merge with its own vertex's η in the MIS weights.
-//! Measured on the pool at 8 s, two seeds: relMSE 0.0104 / 0.0101 against
-//! 0.0134 / 0.0140 with one radius; at equal iterations (90) on the
-//! Cornell box 0.00090 / 0.00085 / 0.00087 against 0.00092 / 0.00087 /
-//! 0.00088, where the lookups cost ~5 % of the time.
+//! sparse, each merge with its own vertex's η in the MIS weights; dropped
+//! where it would equal the global radius (the Cornell box). Measured on
+//! the pool at 8 s, two seeds: relMSE 0.0104 / 0.0101 against 0.0134 /
+//! 0.0140 with one radius; the equal-time benchmark's ratio to sppm went
+//! from 0.97 / 1.01 / 0.97 to about 0.8 / 0.75 / 0.75 (4 / 8 / 16 s).
 //!
 //! **Light tracing on direct light (a limit of density-based weights).** The
 //! power heuristic weighs techniques by density alone. On the Cornell box
@@ -555,11 +555,15 @@ impl Integrator for VcmIntegrator {
         let mut s = if pending {
             format!("iteration {}, radius from a pilot pass", next_pass + 1)
         } else {
-            format!(
-                "iteration {}, radius {:.4}",
-                next_pass + 1,
-                self.radius(next_pass)
-            )
+            let r = self.radius(next_pass);
+            let local = match self.radius0.get() {
+                Some((r0, Some(field))) => {
+                    let (lo, hi) = field.range();
+                    format!(" (over the scene {:.4}–{:.4})", lo * r / r0, hi * r / r0)
+                }
+                _ => String::new(),
+            };
+            format!("iteration {}, radius {r:.4}{local}", next_pass + 1)
         };
         let stored = self.stored.load(Ordering::Relaxed);
         if stored > 0 {

@@ -55,6 +55,11 @@
 //! to the light). The equal-time benchmark's early points are the ones
 //! that missed its target. The other scenes checked are above 2 footprints
 //! already.
+//!
+//! **The radius field.** With `localradius` (the default) the same pilot,
+//! with three more light passes of its own, gives every cell of space its
+//! own K-neighbour radius around the global one ([`field_for`], module doc
+//! of [`super::field`]).
 
 use super::field::{cell_key, FactorField, RadiusField, FIELD_PASSES};
 use super::light::LightVertex;
