@@ -56,8 +56,9 @@ pub struct LightVertex {
     pub beta: SampledSpectrum,
     /// Its partial MIS quantities.
     pub mis: Partial,
-    /// The MIS factors at its position (a radius field's, [`super::field`]).
-    pub f: Factors,
+    /// mis(η) of a merge at its position ([`Factors::vm`]; a radius
+    /// field's, [`super::field`]).
+    pub vm: f32,
     /// Surface vertices of the light subpath up to this one.
     pub depth: u32,
     /// Its subpath kept only the hero wavelength (dispersion, folded into β).
@@ -446,7 +447,7 @@ impl Visitor<StreamRng> for LightVisitor<'_, '_> {
                 bsdf: *bsdf,
                 beta: v.beta,
                 mis: self.mis,
-                f: self.f_prev,
+                vm: self.f_prev.vm,
                 depth: v.depth,
                 terminated: lam.secondary_terminated(),
             });

@@ -320,7 +320,14 @@ impl Partial {
     /// 45; for a light-tracing join eq. 46]. A merge at this vertex counts
     /// where it exists ([`Factors::merges_at`]).
     pub fn connect_weight(&self, pdf_join_a: f32, pdf_rev: f32, f: &Factors, merge: bool) -> f32 {
-        let vm = if merge { f.vm } else { 0.0 };
+        self.connect_weight_vm(pdf_join_a, pdf_rev, if merge { f.vm } else { 0.0 })
+    }
+
+    /// [`Partial::connect_weight`] with the merge at this vertex given by
+    /// its factor `vm` (its [`Factors::vm`], 0 where it does not exist), as
+    /// a stored light vertex keeps it.
+    #[inline]
+    pub fn connect_weight_vm(&self, pdf_join_a: f32, pdf_rev: f32, vm: f32) -> f32 {
         mis(pdf_join_a) * (vm + self.d_vcm + self.d_vc * mis(pdf_rev))
     }
 

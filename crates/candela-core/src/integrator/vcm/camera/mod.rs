@@ -470,9 +470,9 @@ impl CameraVisitor<'_, '_> {
         // the light at the camera's; at a light vertex x_1 its camera-side
         // neighbour is v, not specular.
         let merge_light = self.cp.ff.merges_at(lv.depth == 1, false);
-        let w_light = lv
-            .mis
-            .connect_weight(cam_dir_a, light_rev, &lv.f, merge_light);
+        let w_light =
+            lv.mis
+                .connect_weight_vm(cam_dir_a, light_rev, if merge_light { lv.vm } else { 0.0 });
         let w_cam = self.partial(v.depth + lv.depth).connect_weight(
             light_dir_a,
             cam_rev.0,
