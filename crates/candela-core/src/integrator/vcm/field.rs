@@ -43,7 +43,7 @@
 //! that vertex's radius, so it still integrates to one over the light
 //! vertex's position, and its weight uses the camera vertex's η: the
 //! merged path's vertex is the camera's, as in eq. 38. The brute-force
-//! check ([`super::mis_brute`]) gives every vertex its own radius.
+//! check (`vcm::mis_brute`, a test module) gives every vertex its own radius.
 //!
 //! **Passes stay independent.** The pilot's light passes have pass indices
 //! of their own, so every process of a `--pass-range` render builds the
