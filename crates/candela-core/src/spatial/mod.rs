@@ -24,8 +24,12 @@
 //!   After pbrt-v3's SPPM grid (`src/integrators/sppm.cpp`, PBR 3rd ed.
 //!   §16.2.3).
 //!
-//! All three use closed balls: a point at exactly the radius is inside.
+//! - [`CellMap`] — a value per occupied cell of the same hashed grid, looked
+//!   up by position (VCM's radius field).
+//!
+//! The three search structures use closed balls: a point at exactly the radius is inside.
 
+mod cell_map;
 mod hash_grid;
 mod kdtree;
 mod soa_points;
@@ -35,6 +39,7 @@ mod tests;
 
 use glam::Vec3;
 
+pub use cell_map::CellMap;
 pub use hash_grid::HashGrid;
 pub use kdtree::{Neighbor, PointKdTree};
 pub use sphere_grid::SphereGrid;

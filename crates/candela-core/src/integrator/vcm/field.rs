@@ -51,101 +51,38 @@
 
 use super::mis::{DirectMerges, Factors};
 use crate::math::Vec3;
+use crate::spatial::CellMap;
 
 /// Light passes the field's pilot stores (module doc).
 pub const FIELD_PASSES: u64 = 4;
 
-/// Radii per cell of side `cell`: an open-addressing table keyed by the
-/// cell's integer coordinates.
+/// Radii per cell of space (a [`CellMap`]) and their range.
 #[derive(Clone, Debug)]
 pub struct RadiusField {
-    inv_cell: f32,
-    keys: Vec<[i32; 3]>,
-    radii: Vec<f32>,
-    /// Radius of a cell no pilot vertex fell in.
-    empty: f32,
-    /// Largest radius anywhere.
-    max: f32,
-    /// Smallest radius anywhere.
-    min: f32,
-}
-
-/// A key no cell has (coordinates beyond ±2³¹ are clamped below it).
-const NO_CELL: [i32; 3] = [i32::MIN; 3];
-
-/// The integer coordinates of the cell of side 1/`inv_cell` holding `p`.
-#[inline]
-pub fn cell_key(p: Vec3, inv_cell: f32) -> [i32; 3] {
-    let c = |x: f32| ((x * inv_cell).floor() as i32).max(i32::MIN + 1);
-    [c(p.x), c(p.y), c(p.z)]
+    radii: CellMap<f32>,
+    /// Smallest and largest radius anywhere.
+    range: (f32, f32),
 }
 
 impl RadiusField {
-    /// The field over cells of side `cell` with the radii `cells` (each
-    /// cell's integer coordinates and radius) and `empty` elsewhere.
-    pub fn new(cell: f32, cells: &[([i32; 3], f32)], empty: f32) -> Self {
-        let size = (2 * cells.len()).next_power_of_two().max(2);
-        let mut field = RadiusField {
-            inv_cell: 1.0 / cell,
-            keys: vec![NO_CELL; size],
-            radii: vec![empty; size],
-            empty,
-            max: empty,
-            min: empty,
-        };
-        for &(key, r) in cells {
-            let mut slot = field.slot_of(key);
-            while field.keys[slot] != NO_CELL && field.keys[slot] != key {
-                slot = (slot + 1) & (size - 1);
-            }
-            field.keys[slot] = key;
-            field.radii[slot] = r;
-            field.max = field.max.max(r);
-            field.min = field.min.min(r);
-        }
-        field
-    }
-
-    /// The cell holding `p`.
-    #[inline]
-    pub fn cell_of(&self, p: Vec3) -> [i32; 3] {
-        cell_key(p, self.inv_cell)
-    }
-
-    #[inline]
-    fn slot_of(&self, key: [i32; 3]) -> usize {
-        let h = (key[0] as u32).wrapping_mul(73_856_093)
-            ^ (key[1] as u32).wrapping_mul(19_349_663)
-            ^ (key[2] as u32).wrapping_mul(83_492_791);
-        h as usize & (self.keys.len() - 1)
+    /// The field of the radii in `radii`.
+    pub fn new(radii: CellMap<f32>) -> Self {
+        let empty = radii.empty();
+        let range = radii
+            .values()
+            .fold((empty, empty), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+        RadiusField { radii, range }
     }
 
     /// The radius at `p`.
     #[inline]
     pub fn at(&self, p: Vec3) -> f32 {
-        let key = self.cell_of(p);
-        let mask = self.keys.len() - 1;
-        let mut slot = self.slot_of(key);
-        loop {
-            let k = self.keys[slot];
-            if k == key {
-                return self.radii[slot];
-            }
-            if k == NO_CELL {
-                return self.empty;
-            }
-            slot = (slot + 1) & mask;
-        }
-    }
-
-    /// The largest radius anywhere.
-    pub fn max(&self) -> f32 {
-        self.max
+        self.radii.get(p)
     }
 
     /// The smallest and the largest radius anywhere.
     pub fn range(&self) -> (f32, f32) {
-        (self.min, self.max)
+        self.range
     }
 }
 
@@ -230,29 +167,31 @@ impl<'a> FactorField<'a> {
 mod tests {
     use super::*;
 
-    /// Every cell given is found at every point inside it, points in no
-    /// given cell get the empty radius, and colliding keys (a table of 2
-    /// slots per cell, so probes wrap) all keep their own radius.
+    /// Every cell entered is found at every point inside it and keeps its
+    /// own radius (200 cells in a table of 400 slots, so probes collide and
+    /// wrap); points in no entered cell get the empty radius; the range
+    /// spans both.
     #[test]
     fn cells_are_found_where_they_are() {
         let cell = 0.5;
-        let cells: Vec<([i32; 3], f32)> = (0..200)
-            .map(|i| ([i % 7 - 3, i / 7 - 14, (i * 31) % 11 - 5], 1.0 + i as f32))
-            .collect();
-        let field = RadiusField::new(cell, &cells, 0.25);
-        for &(key, r) in &cells {
-            for (dx, dy, dz) in [(0.01, 0.01, 0.01), (0.49, 0.25, 0.49)] {
-                let p = Vec3::new(
-                    (key[0] as f32 + dx) * cell,
-                    (key[1] as f32 + dy) * cell,
-                    (key[2] as f32 + dz) * cell,
-                );
-                assert_eq!(field.cell_of(p), key);
-                assert_eq!(field.at(p), r, "{key:?}");
+        let mut map = CellMap::new(Vec3::ZERO, cell, 200, 0.25f32);
+        let corner = |i: i32| {
+            Vec3::new(
+                (i % 7 - 3) as f32,
+                (i / 7 - 14) as f32,
+                ((i * 31) % 11 - 5) as f32,
+            ) * cell
+        };
+        for i in 0..200 {
+            *map.entry(corner(i) + Vec3::splat(0.01)) = 1.0 + i as f32;
+        }
+        let field = RadiusField::new(map);
+        for i in 0..200 {
+            for d in [Vec3::splat(0.01), Vec3::new(0.49, 0.25, 0.49)] {
+                assert_eq!(field.at(corner(i) + d), 1.0 + i as f32, "cell {i}");
             }
         }
         assert_eq!(field.at(Vec3::splat(100.0)), 0.25);
-        assert_eq!(field.max(), 200.0);
         assert_eq!(field.range(), (0.25, 200.0));
     }
 }

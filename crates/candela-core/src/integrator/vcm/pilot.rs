@@ -61,16 +61,15 @@
 //! own K-neighbour radius around the global one ([`field_for`], module doc
 //! of [`super::field`]).
 
-use super::field::{cell_key, FactorField, RadiusField, FIELD_PASSES};
+use super::field::{FactorField, RadiusField, FIELD_PASSES};
 use super::light::LightVertex;
 use super::mis::DirectMerges;
 use super::VcmIntegrator;
 use crate::integrator::sppm::passes::pass_wavelengths;
 use crate::integrator::RenderContext;
 use crate::math::Vec3;
-use crate::spatial::HashGrid;
+use crate::spatial::{CellMap, HashGrid};
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::sync::atomic::AtomicU64;
 
 /// Other light vertices the default radius's disk holds around the median
@@ -183,14 +182,15 @@ pub fn field_for(points: &[Vec3], r_g: f32, passes: u64, footprint: f32) -> Opti
         })
         .collect();
     // Per cell: the sum of the neighbour counts and the vertices counted.
-    let mut sums: HashMap<[i32; 3], (f64, u32)> = HashMap::new();
+    let origin = points.iter().fold(Vec3::INFINITY, |m, &p| m.min(p));
+    let mut sums = CellMap::new(origin, r_g, queries.len(), (0.0f64, 0u32));
     for (&p, &c) in queries.iter().zip(&counts) {
-        let e = sums.entry(cell_key(p, 1.0 / r_g)).or_insert((0.0, 0));
+        let e = sums.entry(p);
         e.0 += f64::from(c);
         e.1 += 1;
     }
     let k = f64::from(TARGET_NEIGHBOURS) * passes as f64;
-    let radius_of = |sum: f64, n: u32| {
+    let radius_of = |(sum, n): (f64, u32)| {
         let mean = sum / f64::from(n);
         let r = if mean > 0.0 {
             (f64::from(r_g) * (k / mean).sqrt()) as f32
@@ -202,18 +202,11 @@ pub fn field_for(points: &[Vec3], r_g: f32, passes: u64, footprint: f32) -> Opti
     // The share of the vertices whose cell's radius is not the global one.
     let moved: u32 = sums
         .values()
-        .filter(|&&(sum, n)| (radius_of(sum, n) / r_g - 1.0).abs() > FIELD_DIFFERENCE)
+        .filter(|&&v| (radius_of(v) / r_g - 1.0).abs() > FIELD_DIFFERENCE)
         .map(|&(_, n)| n)
         .sum();
     let share = f64::from(moved) / queries.len().max(1) as f64;
-    if share < FIELD_MIN_SHARE {
-        return None;
-    }
-    let cells: Vec<([i32; 3], f32)> = sums
-        .into_iter()
-        .map(|(key, (sum, n))| (key, radius_of(sum, n)))
-        .collect();
-    Some(RadiusField::new(r_g, &cells, hi))
+    (share >= FIELD_MIN_SHARE).then(|| RadiusField::new(sums.map(hi, radius_of)))
 }
 
 /// The radius whose disk holds [`TARGET_NEIGHBOURS`] other points around
