@@ -76,6 +76,36 @@ fn every_mode_agrees_with_the_path_tracer_on_the_cornell_box() {
     }
 }
 
+/// A light seen from the lens is made by two techniques: the camera's ray
+/// hitting it (s = 0) and light tracing's join of the light's own point x_0
+/// to the lens (s = 1, t = 1). An emitting quad just larger than the view
+/// gives them nearly equal densities (the camera's density of x_0 per light
+/// path, about 1/(area seen), against the emission's 1/A), so each carries
+/// about half of every pixel, and with `maxdepth 0` nothing else is drawn:
+/// a weight that does not complement the other's moves every block. Seen
+/// to fail (measured once each): light tracing's weight taken as at least
+/// 0.99, and the camera's ray weighed 1 as before light tracing joined x_0.
+#[test]
+fn a_light_seen_directly_is_shared_with_light_tracing() {
+    let scene = |integrator: &str| {
+        format!(
+            r#"LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" [40]
+Film "rgb" "integer xresolution" [32] "integer yresolution" [32] "string filename" ["x.exr"]
+Sampler "independent"
+Integrator {integrator} "integer maxdepth" [0]
+WorldBegin
+AreaLightSource "diffuse" "rgb L" [1 1 1]
+Shape "trianglemesh" "point3 P" [-0.6 -0.6 1.5  0.6 -0.6 1.5  0.6 0.6 1.5  -0.6 0.6 1.5]
+  "integer indices" [0 2 1 0 3 2]
+"#
+        )
+    };
+    let pt = block_means(&scene("\"path\""), 16);
+    let m = block_means(&scene(&vcm("vcm", 0.02)), 16);
+    stats::assert_blocks_agree(&pt, &m, "a light seen directly: PT vs vcm");
+}
+
 /// With `connections all`, mode `bpt` is BDPT's estimator (every
 /// connection, one shadow ray each).
 #[test]

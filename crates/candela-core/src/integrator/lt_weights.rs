@@ -113,8 +113,10 @@ impl LtWeights {
         &self.c[i..i + LENGTHS]
     }
 
-    /// c in `row` for a path of `k` scattering vertices (1 for k = 0,
-    /// which light tracing cannot make but a light seen directly).
+    /// c in `row` for a path of `k` scattering vertices (1 for k = 0, a
+    /// light seen directly: the pilot does not measure it, and there the
+    /// camera's variance is that of a light's edges, which light tracing's
+    /// joins of the light's points render without).
     #[inline]
     pub fn at(row: &[f32], k: u32) -> f32 {
         if k == 0 {

@@ -294,12 +294,15 @@ impl VcmIntegrator {
         // it enters d_VCM when the walk reaches x_1 (`LightVisitor::vertex`).
         let by_area = scene.light(id).samples_li_by_area();
         let nee_from = (!by_area).then_some((id, ls.vertex.it));
+        if let Some(buf) = buf.as_deref_mut() {
+            if self.techniques.connect || self.techniques.light_only {
+                // An area light's `direct` is its position density here.
+                self.splat_light_point(ctx, &ls, direct, lambda, &mut rng, buf);
+            }
+        }
         let direct = if nee_from.is_some() { 1.0 } else { direct };
         let f_prev = f.at(ls.vertex.p());
         let mis = Partial::light(direct, emission, cos, ty.is_delta(), &f_prev);
-        if let (true, Some(buf)) = (self.techniques.light_only, buf.as_deref_mut()) {
-            self.splat_light_point(ctx, &ls.vertex, &ls, lambda, &mut rng, buf);
-        }
         let w = Walk {
             mode: TransportMode::Importance,
             max_depth: self.settings.max_depth,
@@ -325,34 +328,59 @@ impl VcmIntegrator {
         walk(scene, &mut lam, &mut rng, &w, ls.start, &mut visitor);
     }
 
-    /// Light tracing's s = 1, t = 1 (mode `lt` only): a visible area light's
-    /// point seen directly by the camera.
+    /// Light tracing's s = 1, t = 1: a visible area light's point x_0,
+    /// sampled with position density `pos` (selection × area), joined to a
+    /// lens point. Against the camera's ray hitting x_0 (camera.rs,
+    /// `seen_directly_weight`) its weight is 1/(1 + mis(p_cam / pos)), p_cam
+    /// the camera's density of x_0 per light path [eqs. 37, 46 with no
+    /// light vertex before x_0]; 1 in mode `lt`. The splats render a light
+    /// seen directly without the pixel-edge noise of the camera's rays
+    /// (a pixel half on the light's edge is hit in half its rays).
     fn splat_light_point(
         &self,
         ctx: &RenderContext<'_>,
-        v: &Vertex,
         ls: &crate::integrator::subpath::LightStart,
+        pos: f32,
         lambda: &SampledWavelengths,
         rng: &mut StreamRng,
         buf: &mut SplatBuffer,
     ) {
+        let v = &ls.vertex;
         let it = v.it;
-        let hittable = v.is_hittable_light(ctx.scene);
         let u = rng.u2();
-        if !it.is_surface() || !hittable {
+        if !it.is_surface() || !v.is_hittable_light(ctx.scene) || !ctx.camera.is_connectable() {
             return;
         }
         let Some(cs) = ctx.camera.sample_wi(&it, u) else {
             return;
         };
-        if cs.pdf.0 <= 0.0 || !ctx.scene.unoccluded(&it, &cs.p_lens) {
+        if cs.pdf.0 <= 0.0 || cs.we == 0.0 {
             return;
         }
         let le = v.light_id().map_or(SampledSpectrum::zero(), |id| {
             ctx.scene.light(id).l(it.p, it.n, it.uv, cs.wi, lambda)
         });
-        let g = cs.wi.dot(it.n).abs() * cs.we / (ls.pmf * ls.pdf_pos.0 * cs.pdf.0);
-        buf.add(cs.p_raster, le * (g * self.splat_scale(ctx)), lambda);
+        if le.is_black() {
+            return;
+        }
+        let cos = cs.wi.dot(it.n).abs();
+        let w = if self.techniques.light_only {
+            1.0
+        } else {
+            let d2 = (cs.p_lens.p - it.p).length_squared();
+            let pdf_dir = ctx.camera.pdf_we(&Ray::new(cs.p_lens.p, -cs.wi)).1;
+            let pdf_cam_a =
+                self.pixel_density(pdf_dir, ctx) * cos / (d2 * self.light_paths(ctx) as f32);
+            weight(super::mis::mis(pdf_cam_a / pos), 0.0)
+        };
+        let Some(w) = thin(w, self.settings.join_roulette, || rng.u1()) else {
+            return;
+        };
+        if !ctx.scene.unoccluded(&it, &cs.p_lens) {
+            return;
+        }
+        let g = cos * cs.we / (ls.pmf * ls.pdf_pos.0 * cs.pdf.0);
+        buf.add(cs.p_raster, le * (g * w * self.splat_scale(ctx)), lambda);
     }
 }
 

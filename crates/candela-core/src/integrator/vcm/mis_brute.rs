@@ -1,6 +1,6 @@
-//! Brute-force check of VCM's MIS weights: for random paths of 2–7
+//! Brute-force check of VCM's MIS weights: for random paths of 1–7
 //! segments (random diffuse/glossy densities, specular vertices, area,
-//! point and infinite lights) every technique's weight from the recursive
+//! point and infinite lights; one segment: a light seen from the lens) every technique's weight from the recursive
 //! quantities of [`super::mis`] equals the power-heuristic weight computed
 //! from every technique's full path density, and the weights sum to one
 //! [Veach 1997, eq. 9.13; Georgiev et al. 2012, eqs. 20, 37].
@@ -11,7 +11,8 @@
 //! - connection s (s light vertices, 0 ≤ s ≤ m + 1): Π_{k<s} pL(x_k) ·
 //!   Π_{k≥s} pE(x_k), times N_light for s = m + 1 (light tracing: every
 //!   light path splats), whose heuristic term is also multiplied by the
-//!   path's variance factor c ([`super::variance`]; √c on the density);
+//!   path's variance factor c ([`super::variance`]; √c on the density;
+//!   c = 1 when m = 0, where light tracing joins x_0 itself);
 //! - merge at x_i (1 ≤ i ≤ m): Π_{k≤i} pL(x_k) · Π_{k≥i} pE(x_k) · π r² N_light;
 //!   at x_1, next to the light, only with `directmerges always`, or
 //!   `afterspecular` (the default) when x_2 is specular;
@@ -78,7 +79,8 @@ fn uniform(rng: &mut StreamRng, lo: f32, hi: f32) -> f32 {
 }
 
 impl Path {
-    /// A random path with `m` scattering vertices.
+    /// A random path with `m` scattering vertices (0: the lens sees the
+    /// light).
     fn random(rng: &mut StreamRng, m: usize) -> Self {
         let light = match (rng.u1() * 3.0) as u32 {
             0 => Emitter::Area,
@@ -130,7 +132,7 @@ impl Path {
             } else {
                 (0..=m).map(|_| uniform(rng, 0.002, 0.05)).collect()
             },
-            lt_c: if rng.u1() < 0.25 {
+            lt_c: if m == 0 || rng.u1() < 0.25 {
                 1.0
             } else {
                 uniform(rng, 1.0 / 32.0, 1.0)
@@ -154,7 +156,10 @@ impl Path {
     /// (direct, emission, cos at the light) as `light_densities` gives them.
     fn light_densities(&self) -> (f32, f32, f32) {
         match self.light {
-            Emitter::Area => (self.p_nee, self.p_pos * self.p_dir, self.seg[0].1),
+            Emitter::Area => {
+                let cos = self.seg.first().map_or(self.cam.1, |s| s.1);
+                (self.p_nee, self.p_pos * self.p_dir, cos)
+            }
             Emitter::Point => (self.p_pos, self.p_pos * self.p_dir, 1.0),
             Emitter::Infinite => (self.p_inf_dir, self.p_inf_dir * self.p_pos, 1.0),
         }
@@ -212,6 +217,8 @@ fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
     for s in 0..=m + 1 {
         let ok = match s {
             0 => p.light == Emitter::Area || p.light == Emitter::Infinite,
+            // Light tracing joins x_0 itself only on an area light.
+            1 if m == 0 => p.light == Emitter::Area,
             _ if s == m + 1 => !p.specular(m),
             _ => !p.specular(s) && !p.specular(s - 1),
         };
@@ -222,7 +229,11 @@ fn brute_force(p: &Path, direct: DirectMerges) -> Vec<(Technique, f64)> {
                 1.0
             };
             // Next-event estimation samples x_0 with its own density.
-            let l = if s == 1 { p.p_nee as f64 } else { light(s) };
+            let l = if s == 1 && m > 0 {
+                p.p_nee as f64
+            } else {
+                light(s)
+            };
             out.push((Technique::Connect(s), n * l * camera(s)));
         }
     }
@@ -347,6 +358,9 @@ fn recursive(p: &Path, f: &[Factors]) -> Vec<(Technique, f32)> {
     // The camera reached x_1 by a delta scattering (at x_2).
     let x1_after_delta = m >= 2 && p.delta[2];
     let mut out = Vec::new();
+    if m == 0 {
+        return seen_directly(p, &emitted);
+    }
     if p.light != Emitter::Point {
         out.push((
             Technique::Connect(0),
@@ -399,6 +413,26 @@ fn recursive(p: &Path, f: &[Factors]) -> Vec<(Technique, f32)> {
         }
     }
     out
+}
+
+/// The weights of a light seen from the lens (m = 0), as camera.rs
+/// (`seen_directly_weight`) and light.rs (`splat_light_point`) make them.
+fn seen_directly(p: &Path, emitted: &Partial) -> Vec<(Technique, f32)> {
+    match p.light {
+        Emitter::Area => {
+            let pdf_cam_a = p.pdf_pixel * p.cam.1 / (p.cam.0 * p.n_light);
+            vec![
+                (
+                    Technique::Connect(0),
+                    weight(0.0, mis(p.p_pos) * emitted.d_vcm),
+                ),
+                (Technique::Connect(1), weight(mis(pdf_cam_a / p.p_pos), 0.0)),
+            ]
+        }
+        // Seen straight from the lens only the camera finds it.
+        Emitter::Infinite => vec![(Technique::Connect(0), 1.0)],
+        Emitter::Point => Vec::new(),
+    }
 }
 
 /// How far the recursive weights (from the densities of `given`) are from
@@ -462,11 +496,11 @@ const DIRECT: [DirectMerges; 3] = [
     DirectMerges::Never,
 ];
 
-/// Fixed seeds: 6000 random paths, 1000 per length 2..=7.
+/// Fixed seeds: 7000 random paths, 1000 per length 1..=7.
 fn paths() -> impl Iterator<Item = Path> {
-    (0..6000u64).map(|i| {
+    (0..7000u64).map(|i| {
         let mut rng = StreamRng::new(0x6d69_7362, i, 0);
-        Path::random(&mut rng, 1 + (i % 6) as usize)
+        Path::random(&mut rng, (i % 7) as usize)
     })
 }
 
@@ -488,8 +522,8 @@ fn recursive_weights_equal_brute_force_and_sum_to_one() {
             checked += 1;
         }
         // Nearly every path has a technique (all-specular paths under a
-        // point light have none).
-        assert!(checked > 5000, "{checked}");
+        // point light, and a point light seen from the lens, have none).
+        assert!(checked > 5800, "{checked}");
     }
 }
 

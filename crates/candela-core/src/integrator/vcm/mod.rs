@@ -17,7 +17,14 @@
 //! **An iteration is a pass.** Pass i: (1) [`light`] walks N_light light
 //! subpaths (default one per pixel of the full film), stores their
 //! non-specular vertices with their MIS quantities, and splats their
-//! connections to the camera; (2) a `HashGrid` over the stored vertices
+//! connections to the camera, from the light's own point x_0 on (a light
+//! seen directly is shared between the camera's rays and light tracing, as
+//! in BDPT; SmallVCM leaves it to the camera, whose one ray per pixel and
+//! pass makes a pixel on a light's edge noisy: on the Cornell box at 128²,
+//! 90 iterations, seeds 1–3, the error of the 10 × 32 pixels around the
+//! light fell from 0.000119 / 0.000090 / 0.000085 to 0.000051 / 0.000053 /
+//! 0.000064 of the image's relMSE, the image's from 0.000922 / 0.000870 /
+//! 0.000882 to 0.000858 / 0.000849 / 0.000853, for 2.5 % more time); (2) a `HashGrid` over the stored vertices
 //! with cells of 2r, and compact copies of them in its order (`merge`);
 //! (3) `camera` walks one camera subpath per pixel, connecting to the light subpath of the same index and merging with every
 //! stored vertex within r. The radius of pass i (0-based) is

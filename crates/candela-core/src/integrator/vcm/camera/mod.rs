@@ -39,7 +39,7 @@ use super::densities::light_densities;
 use super::field::FactorField;
 use super::light::{LightPaths, LightVertex, PrevVertex};
 use super::merge::{MergeGrid, Photon};
-use super::mis::{thin, weight, CameraDeferred, CameraPartial, Factors, Partial};
+use super::mis::{mis, thin, weight, CameraDeferred, CameraPartial, Factors, Partial};
 use super::resample::Resampler;
 use super::variance::{ByLength, LtWeights, LENGTHS};
 use super::{Connections, VcmIntegrator};
@@ -377,21 +377,35 @@ impl CameraVisitor<'_, '_> {
         if le.is_black() {
             return;
         }
-        let (direct, emission, _) = light_densities(scene, id, &v.it, v.wo);
-        // Next-event estimation at the vertex left would have sampled this
-        // point with its own density (nee.rs, `nee_area_density`).
-        let light = scene.light(id);
-        let direct = if !light.samples_li_by_area() {
-            nee_area_density(scene, id, &v.it, &self.nee_ctx)
-        } else {
-            direct
-        };
+        // For an area light the first density is its emission's position
+        // density (selection × area).
+        let (pos, emission, _) = light_densities(scene, id, &v.it, v.wo);
         let w = if v.depth == 1 {
-            1.0
+            self.seen_directly_weight(pos)
         } else {
+            // Next-event estimation at the vertex left would have sampled
+            // this point with its own density (nee.rs, `nee_area_density`).
+            let direct = if scene.light(id).samples_li_by_area() {
+                pos
+            } else {
+                nee_area_density(scene, id, &v.it, &self.nee_ctx)
+            };
             self.emission_weight(direct, emission, v.depth - 1)
         };
         self.add(v.depth - 1, v.beta * le * w);
+    }
+
+    /// The weight of an area light's point seen straight from the lens
+    /// against light tracing's s = 1, t = 1, which samples the same point
+    /// with the emission's position density `pos` (light.rs,
+    /// `splat_light_point`) [eq. 43 with d_VC = 0]: the camera's
+    /// d_VCM after the hit is mis(N_light d² / (p_pixel cos)). Light
+    /// tracing's factor c is 1 at k = 0 ([`LtWeights::at`]).
+    fn seen_directly_weight(&self, pos: f32) -> f32 {
+        if !self.vcm.techniques.connect {
+            return 1.0;
+        }
+        weight(0.0, mis(pos) * self.partial(0).d_vcm)
     }
 
     /// Connections to the vertices of the pixel's light subpath [eqs.

@@ -81,11 +81,32 @@ fn the_next_event_density_is_the_samplers() {
     let (caught, tried) = catches(
         1200,
         DirectMerges::AfterSpecular,
-        |p| p.light == Emitter::Area && (p.p_nee / p.p_pos - 1.0).abs() > 0.2,
+        |p| p.m() > 0 && p.light == Emitter::Area && (p.p_nee / p.p_pos - 1.0).abs() > 0.2,
         |_, t| matches!(t, Technique::Connect(0 | 1)),
         1e-3,
         |p| Path {
             p_nee: p.p_pos,
+            ..p.clone()
+        },
+    );
+    assert!(tried > 50 && caught == tried, "{caught}/{tried}");
+}
+
+/// A light seen from the lens is weighed against light tracing's join of
+/// its point x_0 with the emission's position density (selection × area),
+/// which sampled x_0: weighing both with the next-event density instead is
+/// caught on every such area-light path where the two differ by more than
+/// 20 % and each technique carries more than 1e-3 of the weight.
+#[test]
+fn a_light_seen_directly_is_weighed_with_its_position_density() {
+    let (caught, tried) = catches(
+        2800,
+        DirectMerges::AfterSpecular,
+        |p| p.m() == 0 && p.light == Emitter::Area && (p.p_nee / p.p_pos - 1.0).abs() > 0.2,
+        |_, t| *t == Technique::Connect(0),
+        1e-3,
+        |p| Path {
+            p_pos: p.p_nee,
             ..p.clone()
         },
     );
