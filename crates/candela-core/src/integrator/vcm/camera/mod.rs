@@ -439,14 +439,11 @@ impl CameraVisitor<'_, '_> {
                         r.offer((lv, x, w), x.average());
                     }
                 }
-                let Some(((lv, x, w), inv_p)) = r.pick() else {
-                    return;
-                };
-                let Some(kept) = thin(w, tau, || rng.u1()) else {
+                let Some(((lv, x, _), inv_p)) = r.pick() else {
                     return;
                 };
                 if scene.unoccluded(&lv.it, &v.it) {
-                    self.add(v.depth + lv.depth, x * (inv_p * kept / w));
+                    self.add(v.depth + lv.depth, x * inv_p);
                 }
             }
         }
