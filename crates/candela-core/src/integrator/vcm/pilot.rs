@@ -123,6 +123,12 @@ pub(super) fn density_radius(
     if !vcm.settings.local_radius || points.is_empty() {
         return Some((r, None));
     }
+    // One pass's counts already tell a field that would be dropped (module
+    // doc of [`super::field`]): their noise moves more cells away from r_g,
+    // not fewer, so the other passes are traced only when it is kept.
+    if field_for(&points, r, 1, footprint).is_none() {
+        return Some((r, None));
+    }
     for k in 1..FIELD_PASSES {
         points.extend(pilot_points(vcm, ctx, footprint, PILOT_PASS - k)?);
     }
