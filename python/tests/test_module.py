@@ -189,8 +189,12 @@ def test_a_signal_handler_that_raises_stops_the_render(cornell):
 
 
 def test_ctrl_c_stops_a_render_with_keyboard_interrupt(tmp_path):
+    # The child restores Python's own Ctrl-C handler: a test run started in
+    # the background by a non-interactive shell inherits SIGINT ignored, and
+    # Python then installs no handler, so Ctrl-C (rightly) does nothing.
     script = (
-        "import sys, time, candela\n"
+        "import signal, sys, time, candela\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         f"scene = candela.load({str(CORNELL)!r})\n"
         "print('rendering', flush=True)\n"
         "t0 = time.monotonic()\n"
