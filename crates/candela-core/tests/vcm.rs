@@ -227,6 +227,16 @@ fn mode_bpt_agrees_with_bdpt_on_the_cornell_box() {
     stats::assert_blocks_agree(&bd, &bpt, "Cornell BDPT vs vcm mode bpt");
 }
 
+/// Mode `lt` is light tracing alone: every light vertex, and the light's
+/// own point, joined to the lens with weight 1, as `lightpath` does
+/// (leaving out the light's own point fails it: the light's blocks go dark).
+#[test]
+fn mode_lt_agrees_with_lightpath_on_the_cornell_box() {
+    let lp = block_means(&cornell_small("\"lightpath\""), 16);
+    let lt = block_means(&cornell_small(&vcm("lt", 0.02)), 16);
+    stats::assert_blocks_agree(&lp, &lt, "Cornell lightpath vs vcm mode lt");
+}
+
 fn connections(mode: &str, which: &str) -> String {
     format!("{} \"string connections\" \"{which}\"", vcm(mode, 0.02))
 }
