@@ -125,7 +125,7 @@ fn photon_integrators_agree_with_the_path_tracer_on_the_cornell_box() {
 /// white floor: light subpaths must see the square at their path's time, so
 /// the light tracer's and BDPT's shadows blur exactly like the path tracer's
 /// (a light tracer whose paths all ran at time 0 leaves a sharp shadow at the
-/// start position and fails here).
+/// start position and fails here). vcm too, by connections and merges.
 #[test]
 fn path_light_and_bidirectional_tracers_agree_on_a_moving_shadow() {
     let scene = r#"LookAt 0 -4 6  0 0 0  0 0 1
@@ -152,8 +152,21 @@ AttributeEnd
     let pt = block_means(scene, "path", 16);
     let lt = block_means(scene, "lightpath", 16);
     let bd = block_means(scene, "bdpt", 8);
+    // vcm draws one shutter time per iteration for all its subpaths; in
+    // its mode bpm (merges alone) the floor's shadow is wherever the
+    // iteration's photons were blocked, so light subpaths traced at
+    // another time than the camera's (time 0: tried once) fail it.
+    let vc = block_means(scene, "vcm", 16);
+    let bpm = scene.replace(
+        "Integrator \"path\" \"integer maxdepth\" [3]",
+        "Integrator \"vcm\" \"string mode\" \"bpm\" \"float radius\" [0.05] \"integer maxdepth\" [3]",
+    );
+    assert!(bpm.contains("bpm"));
+    let vm = block_means(&bpm, "vcm", 16);
     assert_agree(&pt, &lt, "moving shadow PT vs LT");
     assert_agree(&pt, &bd, "moving shadow PT vs BDPT");
+    assert_agree(&pt, &vc, "moving shadow PT vs VCM");
+    assert_agree(&pt, &vm, "moving shadow PT vs VCM mode bpm");
 }
 
 /// A coated floor with a near-mirror coat (pbrt-v4's caustic-glass floor:
