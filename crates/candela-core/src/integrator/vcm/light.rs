@@ -367,11 +367,10 @@ impl VcmIntegrator {
         let w = if self.techniques.light_only {
             1.0
         } else {
-            let d2 = (cs.p_lens.p - it.p).length_squared();
-            let pdf_dir = ctx.camera.pdf_we(&Ray::new(cs.p_lens.p, -cs.wi)).1;
-            let pdf_cam_a =
-                self.pixel_density(pdf_dir, ctx) * cos / (d2 * self.light_paths(ctx) as f32);
-            weight(super::mis::mis(pdf_cam_a / pos), 0.0)
+            weight(
+                super::mis::mis(self.lens_join_density(ctx, &cs, &it) / pos),
+                0.0,
+            )
         };
         let Some(w) = thin(w, self.settings.join_roulette, || rng.u1()) else {
             return;
@@ -381,6 +380,24 @@ impl VcmIntegrator {
         }
         let g = cos * cs.we / (ls.pmf * ls.pdf_pos.0 * cs.pdf.0);
         buf.add(cs.p_raster, le * (g * w * self.splat_scale(ctx)), lambda);
+    }
+}
+
+impl VcmIntegrator {
+    /// The density with which the camera's ray would have found the point
+    /// `it` that light tracing joined to the lens sample `cs`, per unit
+    /// area there and per light path [tech. rep. eq. 46]: the pixel density
+    /// of the ray's direction times |cos| / d², over N_light.
+    fn lens_join_density(
+        &self,
+        ctx: &RenderContext<'_>,
+        cs: &crate::camera::CameraWiSample,
+        it: &Interaction,
+    ) -> f32 {
+        let d2 = (cs.p_lens.p - it.p).length_squared();
+        let pdf_dir = ctx.camera.pdf_we(&Ray::new(cs.p_lens.p, -cs.wi)).1;
+        self.pixel_density(pdf_dir, ctx) * cs.wi.dot(it.n).abs()
+            / (d2 * self.light_paths(ctx) as f32)
     }
 }
 
@@ -513,11 +530,7 @@ impl LightVisitor<'_, '_> {
         let w = if self.vcm.techniques.light_only {
             1.0
         } else {
-            let d2 = (cs.p_lens.p - v.p()).length_squared();
-            let pdf_dir = ctx.camera.pdf_we(&Ray::new(cs.p_lens.p, -cs.wi)).1;
-            let pdf_pixel = self.vcm.pixel_density(pdf_dir, ctx);
-            let n_light = self.vcm.light_paths(ctx) as f32;
-            let pdf_cam_a = pdf_pixel * cs.wi.dot(v.it.n).abs() / (d2 * n_light);
+            let pdf_cam_a = self.vcm.lens_join_density(ctx, &cs, &v.it);
             let pdf_rev = v.bsdf.as_ref().map_or(0.0, |b| {
                 b.pdf(
                     cs.wi,
